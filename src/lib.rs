@@ -1,0 +1,32 @@
+//! g2tess: dense, watertight, G²-smooth tessellation of glTF triangle meshes.
+//!
+//! # Code map
+//!
+//! The file tree is the architecture. Data flows top to bottom:
+//!
+//! - [`gltf_io`]: reads `.gltf`/`.glb` into a [`gltf_io::Document`] (JSON root plus decoded
+//!   buffers, everything kept) and writes it back. The only module that speaks glTF.
+//! - [`mesh`]: the core's mesh type, [`mesh::TriMesh`] (positions, unit normals, triangles).
+//! - [`topology`]: welds vertices by position into one adjacency; finds boundary, non-manifold,
+//!   degenerate and split-normal edges.
+//! - [`sharpness`]: resolves one blend width `h` per welded edge from glTF extras, sidecar TOML,
+//!   the crease-angle rule and the defaults.
+//! - [`surface`]: the smooth surfaces over a whole mesh (PN triangles, the G² blend of
+//!   Lee–Hwang–Yoon), evaluated with exact normals at any domain point of any triangle.
+//! - [`continuity`]: measures position gap, normal jump and curvature jump across edges.
+//! - [`options`]: the resolved settings that flow down through every stage.
+//!
+//! **Architecture invariant:** [`mesh`], [`topology`], [`surface`] and [`continuity`] take slices
+//! and return values; they know nothing of glTF, files, clap or meshopt, and never fail on bad
+//! geometry (they fall back and report).
+//!
+//! **Architecture invariant:** the library never sees clap, walkdir or notify; those live in the
+//! binary (`src/main.rs`, `src/cli/`).
+
+pub mod continuity;
+pub mod gltf_io;
+pub mod mesh;
+pub mod options;
+pub mod sharpness;
+pub mod surface;
+pub mod topology;

@@ -1,0 +1,6 @@
+//! The `g2tess` command line.
+mod cli;
+
+fn main() {
+    std::process::exit(cli::run());
+}
