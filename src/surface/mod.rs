@@ -1,1 +1,106 @@
-//! TODO
+//! Smooth surfaces over a whole triangle mesh, evaluated with exact unit normals at any domain
+//! point: PN triangles, and the G² blend of Lee, Hwang and Yoon, "Bézier Triangles with G²
+//! Continuity across Boundaries", Symmetry 8(3), 2016 (with the corrections listed below).
+//!
+//! It deliberately does no tessellation, sharing of edge samples or I/O: it maps (triangle,
+//! barycentrics) to a [`SurfacePoint`]. Per-edge widths come in already resolved.
+//!
+//! The surface of triangle f at barycentrics λ = (u, v, w):
+//! 1. `b_f`: the cubic PN triangle of Eq. 1–2 ([`pn`]), with all six edge points in `E`.
+//! 2. Subdomain `k` = the smallest coordinate; the neighbour g across the edge opposite `k`
+//!    is reached by the general neighbour map `μ = Mλ` ([`blend::neighbour_map`]; Eq. 3 is
+//!    right for one labelling only).
+//! 3. `t` from Eq. 4 with `d = √(3/2)·λ_k`, `s` from the nearer corner, `r(s)` from [`Profile`].
+//! 4. `S = α(t)·b_f(λ) + (1 − α(t))·b_g(μ)`: Eq. 5 with its weights swapped back, so that S is
+//!    `b_f` outside the blending regions.
+//! 5. Normals: the analytic `∂_u S × ∂_v S`, through β(t), d, r(s) and s, oriented by the
+//!    interpolated input normals.
+//!
+//! Module map: [`pn`] (control nets, Bernstein basis), [`profile`] (r(s)), [`blend`] (subdomain,
+//! t, β, neighbour map), [`pattern`] (geometry-free per-point weights, cached per lattice), and
+//! `g2.rs` ([`G2Surface`], [`PnSurface`]: nets per triangle, combination, normals).
+
+pub mod blend;
+mod g2;
+pub mod pattern;
+pub mod pn;
+pub mod profile;
+
+use glam::DVec3;
+
+pub use g2::{G2Surface, PnSurface};
+pub use profile::Profile;
+
+/// Largest blend width: at `h = √2/4` the two arcs of `r(s)` fuse into one and the three regions
+/// of a triangle just touch (notes item 4). `h` is a length in the paper's reference triangle
+/// (equilateral, side √2), not in world units.
+pub const H_MAX: f64 = std::f64::consts::SQRT_2 / 4.0;
+
+/// A point of a surface with its unit normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    pub position: DVec3,
+    /// Unit length, on the side of the interpolated input normals.
+    pub normal: DVec3,
+}
+
+/// A smooth surface over every triangle of a mesh.
+pub trait Surface: Sync {
+    /// Position and exact unit normal at barycentrics `bary` (sum 1) of triangle `tri`, corners
+    /// in input order. At a corner (`bary` a unit vector) the position is the input vertex's and
+    /// the normal its normalized input normal.
+    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint;
+
+    /// All points of the level-`level` lattice (`level ≥ 1`) of triangle `tri`, in lattice order
+    /// (see [`lattice_index`]), appended to `out`. Fast implementations reuse a precomputed
+    /// pattern; results equal [`Surface::evaluate`] at [`lattice_bary`] bit for bit.
+    fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
+        out.reserve(lattice_len(level));
+        for j in 0..=level {
+            for i in 0..=level - j {
+                out.push(self.evaluate(tri, lattice_bary(level, i, j)));
+            }
+        }
+    }
+}
+
+/// Index of lattice point `(i, j)` of level `n`. Lattice order, used by every module: for `j` in
+/// `0..=n`, for `i` in `0..=n-j`; point `(i, j)` has barycentrics [`lattice_bary`]`(n, i, j)`.
+#[inline]
+pub fn lattice_index(n: u32, i: u32, j: u32) -> usize {
+    let (n, i, j) = (n as usize, i as usize, j as usize);
+    j * (2 * n + 3 - j) / 2 + i
+}
+
+/// Number of points in the level-`n` lattice, `(n + 1)(n + 2)/2`.
+#[inline]
+pub fn lattice_len(n: u32) -> usize {
+    let n = n as usize;
+    (n + 1) * (n + 2) / 2
+}
+
+/// Barycentrics `((n−i−j)/n, i/n, j/n)` of lattice point `(i, j)`, each an exact integer
+/// division in f64, so corners are exact unit vectors and edge points have an exact 0.
+#[inline]
+pub fn lattice_bary(n: u32, i: u32, j: u32) -> [f64; 3] {
+    let nf = n as f64;
+    [(n - i - j) as f64 / nf, i as f64 / nf, j as f64 / nf]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lattice_index_counts_rows() {
+        let n = 5;
+        let mut idx = 0;
+        for j in 0..=n {
+            for i in 0..=n - j {
+                assert_eq!(lattice_index(n, i, j), idx);
+                idx += 1;
+            }
+        }
+        assert_eq!(idx, lattice_len(n));
+    }
+}
