@@ -229,3 +229,10 @@ fn options_out_of_range_are_reported_too() {
     case.defaults.h = 0.5;
     assert_eq!(case.error(), "options: h must be in [0, 0.3536], got 0.5");
 }
+
+#[test]
+fn shipped_example_sidecar_parses() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/sidecar.example.toml");
+    let sidecar = Sidecar::load(&path).unwrap();
+    assert_eq!(sidecar.level(), Some(8));
+}

@@ -42,10 +42,14 @@ impl fmt::Display for Location {
 /// Displays as `robot.glb: meshes[2].extras.g2tess.edges[5].h: h must be in [0, 0.3536], got 1.7`
 /// or `robot.g2tess.toml:12: edges[1]: edge (12, 40) does not exist in primitive 0 of mesh "Body"`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{location}: {problem}")]
-pub struct SharpnessError {
-    pub location: Location,
-    pub problem: Problem,
+#[error("{}: {}", .0.location, .0.problem)]
+pub struct SharpnessError(Box<Located>);
+
+/// Boxed so that `Result<_, SharpnessError>` stays one pointer wide on the happy path.
+#[derive(Debug, Clone, PartialEq)]
+struct Located {
+    location: Location,
+    problem: Problem,
 }
 
 /// What is wrong, independent of where. `mesh` fields hold a ready label (`mesh "Body"`, `mesh 3`).
@@ -148,6 +152,16 @@ pub enum Problem {
 
 impl SharpnessError {
     pub(crate) fn new(location: Location, problem: Problem) -> Self {
-        SharpnessError { location, problem }
+        SharpnessError(Box::new(Located { location, problem }))
+    }
+
+    /// Where the mistake is.
+    pub fn location(&self) -> &Location {
+        &self.0.location
+    }
+
+    /// What is wrong.
+    pub fn problem(&self) -> &Problem {
+        &self.0.problem
     }
 }
