@@ -23,10 +23,15 @@
 //! **Architecture invariant:** the library never sees clap, walkdir or notify; those live in the
 //! binary (`src/main.rs`, `src/cli/`).
 
+pub mod attributes;
 pub mod continuity;
 pub mod gltf_io;
 pub mod mesh;
+pub mod normals;
+pub mod optimize;
 pub mod options;
 pub mod sharpness;
 pub mod surface;
+pub mod tangents;
+pub mod tessellate;
 pub mod topology;
