@@ -120,9 +120,13 @@ fn canonical_forward(topo: &Topology, tri: usize, k: usize) -> bool {
     from == edge.verts[0]
 }
 
+/// Lower and higher input vertex index, then the triangle and corner for a crease side (or
+/// `u32::MAX` and 0 where both sides share).
+type InputEdgeKey = (u32, u32, u32, u8);
+
 /// An input edge: the unordered pair of input vertex indices, plus (for creases) the triangle
 /// side it belongs to. Half-edges with the same key share output vertices.
-fn input_edge_key(mesh: &TriMesh, crease: bool, tri: usize, k: usize) -> (u32, u32, u32, u8) {
+fn input_edge_key(mesh: &TriMesh, crease: bool, tri: usize, k: usize) -> InputEdgeKey {
     let t = mesh.triangles[tri];
     let a = t[(k + 1) % 3];
     let b = t[(k + 2) % 3];
@@ -153,22 +157,22 @@ fn tessellate_group(
     let tri_count = range.len();
 
     // Input edges of this group, numbered in first-seen order so numbering is deterministic.
-    let mut keys: Vec<((u32, u32, u32, u8), usize, u8)> = Vec::with_capacity(tri_count * 3);
+    let mut keys: Vec<InputEdgeKey> = Vec::with_capacity(tri_count * 3);
     for tri in range.clone() {
         for k in 0..3 {
             let crease = is_crease(topo, h, topo.tri_edges[tri][k]);
-            keys.push((input_edge_key(mesh, crease, tri, k), tri, k as u8));
+            keys.push(input_edge_key(mesh, crease, tri, k));
         }
     }
     let mut order: Vec<usize> = (0..keys.len()).collect();
-    order.sort_by_key(|&i| (keys[i].0, i));
+    order.sort_by_key(|&i| (keys[i], i));
     // input_edge_of[half-edge] = dense id of its input edge, ids in order of first appearance.
     let mut input_edge_of = vec![0u32; keys.len()];
     let mut first_of_id: Vec<usize> = Vec::new();
     let mut run_start = 0;
     while run_start < order.len() {
         let mut run_end = run_start + 1;
-        while run_end < order.len() && keys[order[run_end]].0 == keys[order[run_start]].0 {
+        while run_end < order.len() && keys[order[run_end]] == keys[order[run_start]] {
             run_end += 1;
         }
         let id = first_of_id.len() as u32;
@@ -181,13 +185,13 @@ fn tessellate_group(
     // Renumber ids by first appearance so the output does not depend on the sort.
     let mut renumber = vec![UNSET; first_of_id.len()];
     let mut next = 0u32;
-    for half in 0..keys.len() {
-        let id = input_edge_of[half] as usize;
-        if renumber[id] == UNSET {
-            renumber[id] = next;
+    for id in input_edge_of.iter_mut() {
+        let old = *id as usize;
+        if renumber[old] == UNSET {
+            renumber[old] = next;
             next += 1;
         }
-        input_edge_of[half] = renumber[id];
+        *id = renumber[old];
     }
     let input_edge_count = next as usize;
 
