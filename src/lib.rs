@@ -15,6 +15,7 @@
 //!   Lee–Hwang–Yoon), evaluated with exact normals at any domain point of any triangle.
 //! - [`continuity`]: measures position gap, normal jump and curvature jump across edges.
 //! - [`options`]: the resolved settings that flow down through every stage.
+//! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages.
 //!
 //! **Architecture invariant:** [`mesh`], [`topology`], [`surface`] and [`continuity`] take slices
 //! and return values; they know nothing of glTF, files, clap or meshopt, and never fail on bad
@@ -30,6 +31,7 @@ pub mod mesh;
 pub mod normals;
 pub mod optimize;
 pub mod options;
+pub mod pipeline;
 pub mod sharpness;
 pub mod surface;
 pub mod tangents;
