@@ -1,0 +1,288 @@
+//! Reads the sidecar TOML (`robot.g2tess.toml` beside `robot.glb`, or `--sidecar FILE`) into
+//! [`Block`]s located by line. It deliberately does not check mesh names against an asset
+//! (see [`super::AssetSharpness::new`]) nor match edges against a mesh.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::DVec3;
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::entries::{at, check_crease_angle, check_h, Block, EdgeEntry, Located, RawEdgeFields};
+use super::error::{Location, Problem, SharpnessError};
+
+/// The suffix that turns an asset's stem into its sidecar's file name.
+pub const SIDECAR_SUFFIX: &str = ".g2tess.toml";
+
+/// A parsed, range-checked sidecar file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sidecar {
+    pub(crate) file: PathBuf,
+    pub(crate) asset: Block,
+    pub(crate) level: Option<u32>,
+    pub(crate) meshes: Vec<MeshSection>,
+}
+
+/// One `[mesh."Name"]` or `[mesh.3]` section.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct MeshSection {
+    pub key: MeshKey,
+    /// The line of the section's key, for errors about the section as a whole.
+    pub line: usize,
+    pub block: Block,
+}
+
+/// How a section names its mesh. A key made only of ASCII digits is an index.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum MeshKey {
+    Name(String),
+    Index(usize),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a sidecar table")]
+struct RawSidecar {
+    h: Option<Spanned<f64>>,
+    crease_angle: Option<Spanned<f64>>,
+    level: Option<Spanned<i64>>,
+    #[serde(default)]
+    mesh: BTreeMap<Spanned<String>, RawMesh>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a mesh section")]
+struct RawMesh {
+    h: Option<Spanned<f64>>,
+    crease_angle: Option<Spanned<f64>>,
+    #[serde(default)]
+    edges: Vec<Spanned<RawEdge>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "an edge entry")]
+struct RawEdge {
+    primitive: Option<Spanned<i64>>,
+    a: Option<Spanned<i64>>,
+    b: Option<Spanned<i64>>,
+    from: Option<Spanned<[f64; 3]>>,
+    to: Option<Spanned<[f64; 3]>>,
+    h: Spanned<f64>,
+}
+
+/// The sidecar path for an asset: `dir/robot.glb` → `dir/robot.g2tess.toml`.
+pub fn sidecar_path_for(asset: &Path) -> PathBuf {
+    let stem = asset.file_stem().unwrap_or_default().to_string_lossy();
+    asset.with_file_name(format!("{stem}{SIDECAR_SUFFIX}"))
+}
+
+impl Sidecar {
+    /// Finds and parses the sidecar of `asset`: `explicit` (`--sidecar`) must exist; the one
+    /// beside the asset is optional, so its absence is `Ok(None)`.
+    pub fn discover(
+        asset: &Path,
+        explicit: Option<&Path>,
+    ) -> Result<Option<Sidecar>, SharpnessError> {
+        match explicit {
+            Some(file) => Sidecar::load(file).map(Some),
+            None => {
+                let file = sidecar_path_for(asset);
+                if file.is_file() {
+                    Sidecar::load(&file).map(Some)
+                } else {
+                    Ok(None)
+                }
+            }
+        }
+    }
+
+    /// Reads and parses one sidecar file.
+    pub fn load(file: &Path) -> Result<Sidecar, SharpnessError> {
+        let text = std::fs::read_to_string(file).map_err(|e| {
+            SharpnessError::new(
+                Location::File {
+                    file: file.to_path_buf(),
+                },
+                Problem::Read {
+                    message: e.to_string(),
+                },
+            )
+        })?;
+        Sidecar::parse(file, &text)
+    }
+
+    /// Parses sidecar text; `file` only names it in messages and explain rows.
+    pub fn parse(file: &Path, text: &str) -> Result<Sidecar, SharpnessError> {
+        let lines = LineIndex::new(text);
+        let loc = |span: Range<usize>, path: &str| Location::Toml {
+            file: file.to_path_buf(),
+            line: lines.line_of(span.start),
+            path: path.to_string(),
+        };
+        let raw: RawSidecar = toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(1, |s| lines.line_of(s.start));
+            SharpnessError::new(
+                Location::Toml {
+                    file: file.to_path_buf(),
+                    line,
+                    path: String::new(),
+                },
+                Problem::Toml {
+                    message: e.message().trim_end().trim_end_matches('.').to_string(),
+                },
+            )
+        })?;
+
+        let asset = Block {
+            h: located_h(raw.h.as_ref(), "h", &loc)?,
+            crease_angle: located_crease(raw.crease_angle.as_ref(), "crease_angle", &loc)?,
+            edges: Vec::new(),
+        };
+        let level = match raw.level {
+            None => None,
+            Some(level) => match u32::try_from(*level.get_ref()) {
+                Ok(n) if n >= 1 => Some(n),
+                _ => {
+                    return Err(at(
+                        &loc(level.span(), "level"),
+                        Problem::LevelOutOfRange {
+                            got: *level.get_ref(),
+                        },
+                    ))
+                }
+            },
+        };
+        let mut meshes = Vec::with_capacity(raw.mesh.len());
+        for (key, section) in raw.mesh {
+            let line = lines.line_of(key.span().start);
+            let key = parse_mesh_key(key.get_ref());
+            let mut block = Block {
+                h: located_h(section.h.as_ref(), "h", &loc)?,
+                crease_angle: located_crease(section.crease_angle.as_ref(), "crease_angle", &loc)?,
+                edges: Vec::with_capacity(section.edges.len()),
+            };
+            for (i, edge) in section.edges.iter().enumerate() {
+                block.edges.push(parse_edge(i, edge, &loc)?);
+            }
+            meshes.push(MeshSection { key, line, block });
+        }
+        // Sections in file order, so errors come out in the order the user reads them.
+        meshes.sort_by_key(|m| m.line);
+        Ok(Sidecar {
+            file: file.to_path_buf(),
+            asset,
+            level,
+            meshes,
+        })
+    }
+
+    /// The file this sidecar was read from.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
+    /// The per-asset tessellation level, if the sidecar sets one (at least 1).
+    pub fn level(&self) -> Option<u32> {
+        self.level
+    }
+}
+
+fn parse_mesh_key(key: &str) -> MeshKey {
+    if !key.is_empty() && key.bytes().all(|b| b.is_ascii_digit()) {
+        if let Ok(index) = key.parse() {
+            return MeshKey::Index(index);
+        }
+    }
+    MeshKey::Name(key.to_string())
+}
+
+fn parse_edge(
+    i: usize,
+    edge: &Spanned<RawEdge>,
+    loc: &impl Fn(Range<usize>, &str) -> Location,
+) -> Result<EdgeEntry, SharpnessError> {
+    let path = format!("edges[{i}]");
+    let entry_loc = loc(edge.span(), &path);
+    let raw = edge.get_ref();
+    let index = |v: &Option<Spanned<i64>>, key: &str| -> Result<Option<u64>, SharpnessError> {
+        match v {
+            None => Ok(None),
+            Some(v) => u64::try_from(*v.get_ref()).map(Some).map_err(|_| {
+                at(
+                    &loc(v.span(), &format!("{path}.{key}")),
+                    Problem::WrongType {
+                        expected: "a non-negative integer",
+                        got: v.get_ref().to_string(),
+                    },
+                )
+            }),
+        }
+    };
+    let point = |v: &Option<Spanned<[f64; 3]>>| v.as_ref().map(|p| DVec3::from_array(*p.get_ref()));
+    let fields = RawEdgeFields {
+        primitive: index(&raw.primitive, "primitive")?.map(|p| p as usize),
+        a: index(&raw.a, "a")?,
+        b: index(&raw.b, "b")?,
+        from: point(&raw.from),
+        to: point(&raw.to),
+    };
+    let h =
+        check_h(*raw.h.get_ref()).map_err(|e| at(&loc(raw.h.span(), &format!("{path}.h")), e))?;
+    let name = fields.into_name().map_err(|e| at(&entry_loc, e))?;
+    Ok(EdgeEntry {
+        name,
+        h,
+        at: Arc::new(entry_loc),
+    })
+}
+
+fn located_h(
+    v: Option<&Spanned<f64>>,
+    path: &str,
+    loc: &impl Fn(Range<usize>, &str) -> Location,
+) -> Result<Option<Located<f64>>, SharpnessError> {
+    located(v, path, loc, check_h)
+}
+
+fn located_crease(
+    v: Option<&Spanned<f64>>,
+    path: &str,
+    loc: &impl Fn(Range<usize>, &str) -> Location,
+) -> Result<Option<Located<f64>>, SharpnessError> {
+    located(v, path, loc, check_crease_angle)
+}
+
+fn located(
+    v: Option<&Spanned<f64>>,
+    path: &str,
+    loc: &impl Fn(Range<usize>, &str) -> Location,
+    check: fn(f64) -> Result<f64, Problem>,
+) -> Result<Option<Located<f64>>, SharpnessError> {
+    let Some(v) = v else { return Ok(None) };
+    let here = loc(v.span(), path);
+    let value = check(*v.get_ref()).map_err(|e| at(&here, e))?;
+    Ok(Some(Located {
+        value,
+        at: Arc::new(here),
+    }))
+}
+
+/// Byte offset → 1-based line number, for messages in the `file.toml:12:` form.
+struct LineIndex {
+    starts: Vec<usize>,
+}
+
+impl LineIndex {
+    fn new(text: &str) -> Self {
+        let starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        LineIndex { starts }
+    }
+
+    fn line_of(&self, offset: usize) -> usize {
+        self.starts.partition_point(|&s| s <= offset)
+    }
+}
