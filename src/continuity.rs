@@ -29,10 +29,11 @@ impl Stat {
         if v.is_empty() {
             return Stat::default();
         }
-        v.sort_by(|a, b| a.total_cmp(b).then(std::cmp::Ordering::Equal));
-        if let Some(nan) = v.iter().position(|x| x.is_nan()) {
-            v[nan..].fill(f64::NAN);
-        }
+        // A NaN (a broken evaluation) must show, so it sorts above every number.
+        v.sort_by(|a, b| match (a.is_nan(), b.is_nan()) {
+            (false, false) => a.total_cmp(b),
+            (x, y) => x.cmp(&y),
+        });
         let rank = ((0.95 * v.len() as f64).ceil() as usize).clamp(1, v.len());
         Stat {
             max: v[v.len() - 1],
@@ -189,4 +190,30 @@ pub fn mean_edge_length(topo: &Topology) -> f64 {
         return 1.0;
     }
     lengths.iter().sum::<f64>() / lengths.len() as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stat_is_max_and_nearest_rank_p95_with_nan_on_top() {
+        let mut v: Vec<f64> = (1..=100).rev().map(f64::from).collect();
+        assert_eq!(
+            Stat::of(&mut v),
+            Stat {
+                max: 100.0,
+                p95: 95.0
+            }
+        );
+        let mut v = vec![1.0, -f64::NAN, 2.0];
+        assert!(Stat::of(&mut v).max.is_nan());
+    }
+
+    #[test]
+    fn angle_is_accurate_for_tiny_angles() {
+        let a = DVec3::X;
+        let b = DVec3::new(1.0, 1e-12, 0.0).normalize();
+        assert!((angle_deg(a, b) - 1e-12f64.to_degrees()).abs() < 1e-24);
+    }
 }

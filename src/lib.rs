@@ -7,13 +7,17 @@
 //! - [`gltf_io`]: reads `.gltf`/`.glb` into a [`gltf_io::Document`] (JSON root plus decoded
 //!   buffers, everything kept) and writes it back. The only module that speaks glTF.
 //! - [`mesh`]: the core's mesh type, [`mesh::TriMesh`] (positions, unit normals, triangles).
-//! - [`topology`]: welds vertices by position into one adjacency; finds boundary, non-manifold,
-//!   degenerate and split-normal edges.
+//! - [`topology`]: welds vertices by position into one adjacency ([`topology::Topology`]);
+//!   finds boundary, non-manifold, degenerate and split-normal edges and each triangle edge's
+//!   neighbour.
 //! - [`sharpness`]: resolves one blend width `h` per welded edge from glTF extras, sidecar TOML,
 //!   the crease-angle rule and the defaults.
-//! - [`surface`]: the smooth surfaces over a whole mesh (PN triangles, the G² blend of
-//!   Lee–Hwang–Yoon), evaluated with exact normals at any domain point of any triangle.
-//! - [`continuity`]: measures position gap, normal jump and curvature jump across edges.
+//! - [`surface`]: the smooth surfaces over a whole mesh behind the [`surface::Surface`] trait
+//!   ([`surface::PnSurface`], and [`surface::G2Surface`], the G² blend of Lee–Hwang–Yoon), evaluated
+//!   with exact normals at any domain point of any triangle, or over a whole lattice with cached
+//!   per-(level, h, profile) weights.
+//! - [`continuity`]: measures position gap, normal jump and curvature jump across edges
+//!   ([`continuity::measure`]).
 //! - [`options`]: the resolved settings that flow down through every stage.
 //! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages.
 //!

@@ -147,9 +147,12 @@ impl G2Surface {
         let l = w.bary;
         let interpolated = l[0] * patch.normal[0] + l[1] * patch.normal[1] + l[2] * patch.normal[2];
         let n = du.cross(dv);
-        let len = n.length();
-        let normal = if len > 1e-14 * du.length() * dv.length() && len.is_finite() {
-            let n = n / len;
+        let len2 = n.length_squared();
+        // |N| ≤ 1e-14·|∂_u S|·|∂_v S|: the tangents are parallel to rounding (a degenerate
+        // triangle); fall back to the interpolated input normal.
+        let normal = if len2 > 1e-28 * du.length_squared() * dv.length_squared() && len2.is_finite()
+        {
+            let n = n / len2.sqrt();
             if n.dot(interpolated) < 0.0 {
                 -n
             } else {
