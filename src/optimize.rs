@@ -5,7 +5,7 @@
 //! afterwards from `sources` follow. It deliberately leaves quantization and compression to the
 //! writer.
 
-use crate::tessellate::{DenseMesh, VertexSource};
+use crate::tessellate::DenseMesh;
 use meshopt::VertexDataAdapter;
 
 /// meshoptimizer's cache statistics of an index buffer (ACMR: transformed vertices per
@@ -29,10 +29,14 @@ pub fn cache_figures(mesh: &DenseMesh) -> CacheFigures {
 
 /// Reorders `mesh` in place: vertex cache, optional overdraw (threshold 1.05, meshoptimizer's
 /// recommended value), then vertex fetch. Deterministic.
-pub fn optimize(mesh: &mut DenseMesh, overdraw: bool) {
+///
+/// Returns the vertex remap (old index → new index, `u32::MAX` for a vertex no triangle uses),
+/// so that streams computed later for the same vertices (morph targets) can follow with
+/// [`remap_stream`].
+pub fn optimize(mesh: &mut DenseMesh, overdraw: bool) -> Vec<u32> {
     let vertex_count = mesh.positions.len();
     if mesh.indices.is_empty() || vertex_count == 0 {
-        return;
+        return (0..vertex_count as u32).collect();
     }
     meshopt::optimize_vertex_cache_in_place(&mut mesh.indices, vertex_count);
     if overdraw {
@@ -46,29 +50,26 @@ pub fn optimize(mesh: &mut DenseMesh, overdraw: bool) {
     mesh.indices = meshopt::remap_index_buffer(Some(&mesh.indices), vertex_count, &remap);
     mesh.positions = meshopt::remap_vertex_buffer(&mesh.positions, used, &remap);
     mesh.normals = meshopt::remap_vertex_buffer(&mesh.normals, used, &remap);
-    mesh.sources = remap_sources(&mesh.sources, used, &remap);
+    mesh.sources = remap_stream(&mesh.sources, &remap, used);
+    remap
 }
 
-/// `VertexSource` is not `Default`, so it is remapped by hand with the same table.
-fn remap_sources(sources: &[VertexSource], used: usize, remap: &[u32]) -> Vec<VertexSource> {
-    let mut out = vec![
-        VertexSource {
-            tri: 0,
-            bary: [0.0; 3]
-        };
-        used
-    ];
+/// Applies a remap from [`optimize`] to one more per-vertex stream; `used` is the number of
+/// vertices kept.
+pub fn remap_stream<T: Copy>(stream: &[T], remap: &[u32], used: usize) -> Vec<T> {
+    let mut out: Vec<Option<T>> = vec![None; used];
     for (old, &new) in remap.iter().enumerate() {
         if new != u32::MAX {
-            out[new as usize] = sources[old];
+            out[new as usize] = Some(stream[old]);
         }
     }
-    out
+    out.into_iter().flatten().collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tessellate::VertexSource;
 
     #[test]
     fn reordering_keeps_every_triangle_and_improves_cache() {

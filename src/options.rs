@@ -18,7 +18,7 @@ pub const MAX_H: f64 = std::f64::consts::SQRT_2 / 4.0;
 /// Default crease angle in degrees: edges whose faces meet more sharply get `h = 0`.
 pub const DEFAULT_CREASE_ANGLE: f64 = 60.0;
 /// Default blend profile.
-pub const DEFAULT_PROFILE: Profile = Profile::Paper;
+pub const DEFAULT_PROFILE: Profile = Profile::C2;
 /// Default surface scheme.
 pub const DEFAULT_SCHEME: Scheme = Scheme::G2;
 /// Default cap on output triangles per input file, so a typo in `level` cannot fill the disk.
@@ -27,10 +27,26 @@ pub const DEFAULT_MAX_OUTPUT_TRIANGLES: u64 = 50_000_000;
 pub const DEFAULT_ALLOW_OUTSIDE_URIS: bool = false;
 /// Default: never overwrite an input file.
 pub const DEFAULT_FORCE: bool = false;
+/// Default: hard edges of the input (split normals) are not forced sharp: the surface closes
+/// them smoothly unless the crease-angle rule or an explicit h makes them creases.
+pub const DEFAULT_KEEP_HARD_EDGES: bool = false;
+/// Default: reorder output for the GPU's vertex cache and vertex fetch (meshoptimizer).
+pub const DEFAULT_OPTIMIZE: bool = true;
+/// Default: no overdraw ordering (it costs time and helps only some materials).
+pub const DEFAULT_OVERDRAW: bool = false;
 /// Default: write float attributes (no KHR_mesh_quantization).
 pub const DEFAULT_QUANTIZE: bool = false;
 /// Default: write uncompressed buffers (no EXT_meshopt_compression).
 pub const DEFAULT_COMPRESS: bool = false;
+
+impl From<Profile> for crate::surface::Profile {
+    fn from(p: Profile) -> Self {
+        match p {
+            Profile::Paper => crate::surface::Profile::Paper,
+            Profile::C2 => crate::surface::Profile::C2,
+        }
+    }
+}
 
 /// The radial profile r(s) of the blending region.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -76,6 +92,14 @@ pub struct Options {
     pub allow_outside_uris: bool,
     /// Allow overwriting an input. Default: [`DEFAULT_FORCE`].
     pub force: bool,
+    /// Give hard edges of the input h = 0. Default: [`DEFAULT_KEEP_HARD_EDGES`].
+    pub keep_hard_edges: bool,
+    /// Vertex cache and fetch ordering. Default: [`DEFAULT_OPTIMIZE`].
+    pub optimize: bool,
+    /// Overdraw ordering (after the cache ordering). Default: [`DEFAULT_OVERDRAW`].
+    pub overdraw: bool,
+    /// A sidecar to use instead of `<asset>.g2tess.toml` beside each asset. Default: none.
+    pub sidecar: Option<std::path::PathBuf>,
     /// Quantize output attributes. Default: [`DEFAULT_QUANTIZE`].
     pub quantize: bool,
     /// Compress output buffers. Default: [`DEFAULT_COMPRESS`].
@@ -93,6 +117,10 @@ impl Default for Options {
             max_output_triangles: DEFAULT_MAX_OUTPUT_TRIANGLES,
             allow_outside_uris: DEFAULT_ALLOW_OUTSIDE_URIS,
             force: DEFAULT_FORCE,
+            keep_hard_edges: DEFAULT_KEEP_HARD_EDGES,
+            optimize: DEFAULT_OPTIMIZE,
+            overdraw: DEFAULT_OVERDRAW,
+            sidecar: None,
             quantize: DEFAULT_QUANTIZE,
             compress: DEFAULT_COMPRESS,
         }
@@ -112,6 +140,9 @@ pub struct ConfigFile {
     pub max_output_triangles: Option<u64>,
     pub allow_outside_uris: Option<bool>,
     pub force: Option<bool>,
+    pub keep_hard_edges: Option<bool>,
+    pub optimize: Option<bool>,
+    pub overdraw: Option<bool>,
     pub quantize: Option<bool>,
     pub compress: Option<bool>,
 }
@@ -145,21 +176,46 @@ impl Options {
         macro_rules! take {
             ($($f:ident),*) => { $( if let Some(v) = config.$f { self.$f = v; } )* };
         }
-        take!(level, h, crease_angle, profile, scheme, max_output_triangles, allow_outside_uris, force, quantize, compress);
+        take!(
+            level,
+            h,
+            crease_angle,
+            profile,
+            scheme,
+            max_output_triangles,
+            allow_outside_uris,
+            force,
+            keep_hard_edges,
+            optimize,
+            overdraw,
+            quantize,
+            compress
+        );
         self
     }
 
     /// Checks every range; `origin` names where the values came from.
     pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
-        let err = |key: &str, what: String| Err(ConfigError { at: format!("{origin}: {key}"), what });
+        let err = |key: &str, what: String| {
+            Err(ConfigError {
+                at: format!("{origin}: {key}"),
+                what,
+            })
+        };
         if !(1..=MAX_LEVEL).contains(&self.level) {
-            return err("level", format!("is {} (expected 1 to {MAX_LEVEL})", self.level));
+            return err(
+                "level",
+                format!("is {} (expected 1 to {MAX_LEVEL})", self.level),
+            );
         }
         if !(0.0..=MAX_H).contains(&self.h) {
             return err("h", format!("is {} (expected 0 to {MAX_H:.4})", self.h));
         }
         if !(0.0..=180.0).contains(&self.crease_angle) {
-            return err("crease_angle", format!("is {} (expected 0 to 180 degrees)", self.crease_angle));
+            return err(
+                "crease_angle",
+                format!("is {} (expected 0 to 180 degrees)", self.crease_angle),
+            );
         }
         if self.max_output_triangles == 0 {
             return err("max_output_triangles", "is 0 (expected at least 1)".into());
@@ -188,7 +244,14 @@ mod tests {
 
     #[test]
     fn out_of_range_h_is_refused() {
-        let o = Options::default().overlay(&ConfigFile { h: Some(1.7), ..Default::default() });
-        assert!(o.validate("--h").unwrap_err().what.contains("expected 0 to 0.3536"));
+        let o = Options::default().overlay(&ConfigFile {
+            h: Some(1.7),
+            ..Default::default()
+        });
+        assert!(o
+            .validate("--h")
+            .unwrap_err()
+            .what
+            .contains("expected 0 to 0.3536"));
     }
 }

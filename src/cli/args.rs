@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use clap::{Parser, ValueEnum};
-use g2tess::options::{self, ConfigFile, ConfigError, Options};
+use g2tess::options::{self, ConfigError, ConfigFile, Options};
 
 /// Turns low-poly glTF meshes into dense, watertight G²-smooth meshes with exact normals.
 ///
@@ -40,13 +40,37 @@ pub struct Args {
     #[arg(long, help_heading = "Surface")]
     pub crease_angle: Option<f64>,
 
-    /// Blend profile [default: paper]
+    /// Blend profile [default: c2]
     #[arg(long, value_enum, help_heading = "Surface")]
     pub profile: Option<ProfileArg>,
 
     /// Surface scheme [default: g2]
     #[arg(long, value_enum, help_heading = "Surface")]
     pub scheme: Option<SchemeArg>,
+
+    /// Give hard edges of the input (split normals) h = 0
+    #[arg(long, help_heading = "Surface")]
+    pub keep_hard_edges: bool,
+
+    /// Sidecar with per-mesh and per-edge h, instead of <asset>.g2tess.toml beside each asset
+    #[arg(long, value_name = "FILE", help_heading = "Surface")]
+    pub sidecar: Option<PathBuf>,
+
+    /// Print, for mesh N (index or name), which source set each edge's h, and exit
+    #[arg(long, value_name = "MESH", help_heading = "Surface")]
+    pub explain_h: Option<String>,
+
+    /// Write a JSON report (counts, timings, continuity, warnings per file) to FILE
+    #[arg(long, value_name = "FILE", help_heading = "Output")]
+    pub report: Option<PathBuf>,
+
+    /// Keep the tessellator's triangle and vertex order (skip meshoptimizer's ordering)
+    #[arg(long, help_heading = "Output")]
+    pub no_optimize: bool,
+
+    /// Also order triangles to reduce overdraw
+    #[arg(long, help_heading = "Output")]
+    pub overdraw: bool,
 
     /// Refuse outputs with more triangles than this per file [default: 50000000]
     #[arg(long, value_name = "N", help_heading = "Output")]
@@ -124,10 +148,14 @@ impl Args {
             max_output_triangles: self.max_triangles,
             allow_outside_uris: self.allow_outside_uris.then_some(true),
             force: self.force.then_some(true),
+            keep_hard_edges: self.keep_hard_edges.then_some(true),
+            optimize: self.no_optimize.then_some(false),
+            overdraw: self.overdraw.then_some(true),
             quantize: self.quantize.then_some(true),
             compress: self.compress.then_some(true),
         };
-        let opts = opts.overlay(&flags);
+        let mut opts = opts.overlay(&flags);
+        opts.sidecar = self.sidecar.clone();
         opts.validate("command line")?;
         Ok(opts)
     }

@@ -1,0 +1,54 @@
+//! The pipeline's error: every message names the file it is about (the asset, its sidecar, or
+//! the output) and then where inside it and what was expected.
+
+use std::path::{Path, PathBuf};
+
+use crate::gltf_io;
+use crate::sharpness::SharpnessError;
+
+/// Why one file could not be processed.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Reading or writing the glTF failed, or the asset is invalid or unsupported.
+    #[error("{}: {source}", file.display())]
+    Gltf {
+        /// The file the error is about.
+        file: PathBuf,
+        /// What went wrong, located by JSON path.
+        source: gltf_io::Error,
+    },
+    /// A per-edge h source (extras, sidecar, options) has a mistake; it names its own file.
+    #[error(transparent)]
+    Sharpness(#[from] SharpnessError),
+    /// The work would exceed a resource bound.
+    #[error("{}: {what}", file.display())]
+    Limit {
+        /// The asset.
+        file: PathBuf,
+        /// What would be exceeded and what to do instead.
+        what: String,
+    },
+}
+
+impl Error {
+    /// A glTF-layer error about `file`.
+    pub fn gltf(file: &Path, source: gltf_io::Error) -> Self {
+        Error::Gltf {
+            file: file.to_path_buf(),
+            source,
+        }
+    }
+
+    /// A resource bound about `file`.
+    pub fn limit(file: &Path, what: impl Into<String>) -> Self {
+        Error::Limit {
+            file: file.to_path_buf(),
+            what: what.into(),
+        }
+    }
+
+    /// Whether the environment failed (a disk, a permission) rather than the input.
+    pub fn is_io(&self) -> bool {
+        matches!(self, Error::Gltf { source, .. } if source.kind == gltf_io::ErrorKind::Io)
+    }
+}

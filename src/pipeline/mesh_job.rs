@@ -1,0 +1,315 @@
+//! One mesh through every stage: join its triangle primitives, weld, resolve h, build the
+//! surface, tessellate, carry attributes and morph targets, order for the GPU, split back into
+//! primitives.
+//!
+//! It deliberately does not touch the document: it takes decoded arrays and returns new ones,
+//! so meshes can run in parallel and the caller writes them back in file order.
+
+use std::ops::Range;
+use std::path::Path;
+use std::time::Instant;
+
+use glam::DVec3;
+use serde_json::Value;
+
+use super::error::Error;
+use super::morph;
+use super::primitive_out::{self, Prepared};
+use super::report::{EdgeFigures, MeshReport, PrimitiveReport};
+use crate::gltf_io::{self, PrimitiveData, Values};
+use crate::mesh::TriMesh;
+use crate::options::{Options, Scheme};
+use crate::sharpness::{AssetSharpness, MeshContext, PrimitiveContext};
+use crate::surface::{G2Surface, PnSurface, Surface};
+use crate::tessellate::tessellate;
+use crate::topology::Topology;
+use crate::{normals, optimize};
+
+/// One triangle primitive as read.
+#[derive(Debug, Clone)]
+pub struct PrimitiveInput {
+    /// Its index in the glTF mesh.
+    pub index: usize,
+    /// Its `extras`, for per-edge h.
+    pub extras: Option<Value>,
+    /// `Some(texcoord set)` when tangents must be generated (see the pipeline's rule).
+    pub needs_tangents: Option<u32>,
+    /// The decoded arrays.
+    pub data: PrimitiveData,
+}
+
+/// One glTF mesh's triangle primitives as read.
+#[derive(Debug, Clone)]
+pub struct MeshInput {
+    /// Its index in the document.
+    pub mesh: usize,
+    /// Its name, for sidecar sections and messages.
+    pub name: Option<String>,
+    /// Its `extras`, for per-edge h.
+    pub extras: Option<Value>,
+    /// Its triangle primitives, in file order.
+    pub primitives: Vec<PrimitiveInput>,
+}
+
+/// The replacement primitives of one mesh and what it took.
+#[derive(Debug, Clone)]
+pub struct MeshOutput {
+    /// (primitive index, new data), in file order.
+    pub primitives: Vec<(usize, PrimitiveData)>,
+    /// Counts, timings, continuity, warnings.
+    pub report: MeshReport,
+}
+
+/// Smooths one mesh at `level`.
+pub fn smooth_mesh(
+    input: &MeshInput,
+    sharpness: &AssetSharpness,
+    level: u32,
+    options: &Options,
+    asset: &Path,
+) -> Result<MeshOutput, Error> {
+    let mut report = MeshReport {
+        mesh: input.mesh,
+        name: input.name.clone(),
+        ..MeshReport::default()
+    };
+    let clock = Instant::now();
+    let mut prepared: Vec<Prepared> = input
+        .primitives
+        .iter()
+        .map(|p| prepare(input.mesh, p, options.crease_angle, &mut report.warnings))
+        .collect::<Result<_, _>>()
+        .map_err(|e| Error::gltf(asset, e))?;
+    assign_offsets(&mut prepared);
+    let (mesh, groups) = join(&prepared);
+    let topo = Topology::build(&mesh);
+    report.times.topology = lap(&clock, 0.0);
+
+    let contexts: Vec<PrimitiveContext> = input
+        .primitives
+        .iter()
+        .zip(&prepared)
+        .map(|(p, prep)| PrimitiveContext {
+            index: p.index,
+            extras: p.extras.as_ref(),
+            vertex_offset: prep.vertex_offset,
+            vertex_count: prep.vertex_count(),
+        })
+        .collect();
+    let ctx = MeshContext {
+        index: input.mesh,
+        name: input.name.as_deref(),
+        extras: input.extras.as_ref(),
+        primitives: &contexts,
+    };
+    let params = sharpness.resolve_mesh(&ctx, &mesh, &topo)?;
+    report
+        .warnings
+        .extend(params.warnings.iter().map(|w| w.to_string()));
+    report.times.sharpness = lap(&clock, report.times.topology);
+
+    let surface = build_surface(options, &mesh, &topo, &params.h);
+    report.warnings.extend(
+        topo.warnings()
+            .iter()
+            .map(|w| format!("mesh {}: {w}", input.mesh)),
+    );
+    report.edges = EdgeFigures::measure(surface.as_ref(), &topo, &params.h);
+    let t_surface = lap(&clock, report.times.topology + report.times.sharpness);
+    report.times.surface = t_surface;
+
+    let tess_start = Instant::now();
+    let mut dense = tessellate(&mesh, &topo, &params.h, surface.as_ref(), level, &groups);
+    report.times.tessellate = tess_start.elapsed().as_secs_f64();
+
+    let opt_start = Instant::now();
+    let remaps: Vec<Option<Vec<u32>>> = dense
+        .iter_mut()
+        .map(|d| {
+            options
+                .optimize
+                .then(|| optimize::optimize(d, options.overdraw))
+        })
+        .collect();
+    report.times.optimize = opt_start.elapsed().as_secs_f64();
+
+    let attr_start = Instant::now();
+    let mut primitives = Vec::with_capacity(prepared.len());
+    let targets = morph::targets(
+        &mesh, &topo, &params.h, &prepared, &groups, level, options, &remaps,
+    );
+    for (k, ((prep, d), target)) in prepared.iter().zip(&dense).zip(targets).enumerate() {
+        let data = primitive_out::build(prep, d, groups[k].start as u32, target);
+        report.primitives.push(PrimitiveReport {
+            primitive: input.primitives[k].index,
+            triangles_in: prep.data.indices.len() / 3,
+            vertices_in: prep.source_vertex_count,
+            triangles_out: d.indices.len() / 3,
+            vertices_out: d.positions.len(),
+            cache: optimize::cache_figures(d),
+        });
+        primitives.push((input.primitives[k].index, data));
+    }
+    report.times.attributes = attr_start.elapsed().as_secs_f64();
+    Ok(MeshOutput { primitives, report })
+}
+
+/// Seconds since `clock` minus what earlier stages already took.
+fn lap(clock: &Instant, before: f64) -> f64 {
+    clock.elapsed().as_secs_f64() - before
+}
+
+/// The surface for `scheme`. Hybrid and Coons construct their own; PN is G² with every h = 0.
+pub(super) fn build_surface(
+    options: &Options,
+    mesh: &TriMesh,
+    topo: &Topology,
+    h: &[f64],
+) -> Box<dyn Surface> {
+    match options.scheme {
+        Scheme::Pn => Box::new(PnSurface::new(mesh, topo)),
+        _ => Box::new(G2Surface::new(mesh, topo, h, options.profile.into())),
+    }
+}
+
+/// Checks a primitive's positions and normals, generating normals where there are none.
+fn prepare(
+    mesh: usize,
+    input: &PrimitiveInput,
+    crease_angle: f64,
+    warnings: &mut Vec<String>,
+) -> Result<Prepared, gltf_io::Error> {
+    let at = format!("meshes[{mesh}].primitives[{}]", input.index);
+    let data = &input.data;
+    let positions = match data.attribute("POSITION") {
+        Some(a) if a.components == 3 => match &a.values {
+            Values::Float(v) => v,
+            Values::Uint(_) => unreachable!("positions are decoded as floats"),
+        },
+        Some(a) => {
+            return Err(gltf_io::Error::invalid(
+                format!("{at}.attributes.POSITION"),
+                format!("has {} components (expected 3)", a.components),
+            ))
+        }
+        None => {
+            return Err(gltf_io::Error::invalid(
+                format!("{at}.attributes"),
+                "has no POSITION (expected a triangle primitive with positions)",
+            ))
+        }
+    };
+    if let Some(i) = positions.iter().position(|x| !x.is_finite()) {
+        return Err(gltf_io::Error::invalid(
+            format!("{at}.attributes.POSITION"),
+            format!("vertex {} is not finite (expected finite numbers)", i / 3),
+        ));
+    }
+    let vertex_count = positions.len() / 3;
+    let triangles: Vec<[u32; 3]> = data
+        .indices
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .collect();
+    if let Some(bad) = data.indices.iter().find(|&&i| i as usize >= vertex_count) {
+        return Err(gltf_io::Error::invalid(
+            format!("{at}.indices"),
+            format!("index {bad} is out of range (expected below the vertex count {vertex_count})"),
+        ));
+    }
+    let points: Vec<DVec3> = positions
+        .chunks_exact(3)
+        .map(|p| DVec3::new(p[0].into(), p[1].into(), p[2].into()))
+        .collect();
+    let input_normals = data.attribute("NORMAL").and_then(|a| match &a.values {
+        Values::Float(v) if a.components == 3 => Some(v),
+        _ => None,
+    });
+    match input_normals {
+        Some(n) => {
+            let mut repaired = 0;
+            let normals: Vec<DVec3> = n
+                .chunks_exact(3)
+                .enumerate()
+                .map(|(v, c)| {
+                    let d = DVec3::new(c[0].into(), c[1].into(), c[2].into());
+                    let unit = d.normalize_or_zero();
+                    if unit == DVec3::ZERO || !unit.is_finite() {
+                        repaired += 1;
+                        fallback_normal(&points, &triangles, v as u32)
+                    } else {
+                        unit
+                    }
+                })
+                .collect();
+            if repaired > 0 {
+                warnings.push(format!(
+                    "{at}.attributes.NORMAL: {repaired} zero or non-finite normals replaced by the mean of their faces' normals"
+                ));
+            }
+            Ok(Prepared::new(
+                data.clone(),
+                points,
+                normals,
+                triangles,
+                input.needs_tangents,
+            ))
+        }
+        None => {
+            let generated = normals::generate(&points, &triangles, crease_angle);
+            warnings.push(format!(
+                "{at}: no NORMAL; normals generated (angle-weighted, split at {crease_angle}°)"
+            ));
+            Ok(Prepared::with_generated_normals(
+                data,
+                &points,
+                generated,
+                input.needs_tangents,
+            ))
+        }
+    }
+}
+
+/// The normalized sum of the normals of the faces around input vertex `v` (or +Z).
+fn fallback_normal(points: &[DVec3], triangles: &[[u32; 3]], v: u32) -> DVec3 {
+    let sum: DVec3 = triangles
+        .iter()
+        .filter(|t| t.contains(&v))
+        .map(|t| {
+            let [a, b, c] = t.map(|i| points[i as usize]);
+            (b - a).cross(c - a)
+        })
+        .sum();
+    let n = sum.normalize_or_zero();
+    if n == DVec3::ZERO {
+        DVec3::Z
+    } else {
+        n
+    }
+}
+
+/// The primitives of one mesh as one [`TriMesh`], and each primitive's triangle range in it.
+fn join(prepared: &[Prepared]) -> (TriMesh, Vec<Range<usize>>) {
+    let mut mesh = TriMesh::default();
+    let mut groups = Vec::with_capacity(prepared.len());
+    for p in prepared {
+        let offset = mesh.positions.len() as u32;
+        debug_assert_eq!(offset, p.vertex_offset);
+        mesh.positions.extend_from_slice(&p.positions);
+        mesh.normals.extend_from_slice(&p.normals);
+        let start = mesh.triangles.len();
+        mesh.triangles
+            .extend(p.triangles.iter().map(|t| t.map(|v| v + offset)));
+        groups.push(start..mesh.triangles.len());
+    }
+    (mesh, groups)
+}
+
+/// Vertex offsets of each prepared primitive in the joined mesh.
+fn assign_offsets(prepared: &mut [Prepared]) {
+    let mut offset = 0u32;
+    for p in prepared {
+        p.vertex_offset = offset;
+        offset += p.vertex_count();
+    }
+}

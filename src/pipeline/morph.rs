@@ -1,0 +1,101 @@
+//! Morph targets on the smooth surface: each target's displaced mesh is smoothed with the same
+//! topology, h and lattice, so its dense vertices correspond one to one with the base's.
+//!
+//! Interpolating the input deltas instead would move the dense vertices along the flat
+//! low-poly triangles; re-evaluating the surface keeps the morphed shape as smooth as the base.
+//! It deliberately computes absolute positions and normals only; deltas are taken where the
+//! output primitive is built.
+
+use std::ops::Range;
+
+use glam::DVec3;
+
+use super::primitive_out::Prepared;
+use crate::gltf_io::Values;
+use crate::mesh::TriMesh;
+use crate::optimize::remap_stream;
+use crate::options::Options;
+use crate::tessellate::tessellate;
+use crate::topology::Topology;
+
+/// The surface of one morph target at the output vertices of one primitive.
+#[derive(Debug, Clone, Default)]
+pub struct TargetSurface {
+    /// Absolute positions of the morphed surface.
+    pub positions: Vec<[f32; 3]>,
+    /// Its unit normals.
+    pub normals: Vec<[f32; 3]>,
+}
+
+/// Per primitive, per target: the morphed surface at that primitive's output vertices.
+///
+/// `remaps` are the vertex orders [`crate::optimize::optimize`] gave each primitive (`None`
+/// where it did not run).
+#[allow(clippy::too_many_arguments)]
+pub fn targets(
+    mesh: &TriMesh,
+    topo: &Topology,
+    h: &[f64],
+    prepared: &[Prepared],
+    groups: &[Range<usize>],
+    level: u32,
+    options: &Options,
+    remaps: &[Option<Vec<u32>>],
+) -> Vec<Vec<TargetSurface>> {
+    let count = prepared
+        .iter()
+        .map(|p| p.data.targets.len())
+        .max()
+        .unwrap_or(0);
+    let mut out: Vec<Vec<TargetSurface>> = vec![Vec::with_capacity(count); prepared.len()];
+    for t in 0..count {
+        let moved = displaced(mesh, prepared, t);
+        let surface = super::mesh_job::build_surface(options, &moved, topo, h);
+        let dense = tessellate(&moved, topo, h, surface.as_ref(), level, groups);
+        for (k, d) in dense.into_iter().enumerate() {
+            let (positions, normals) = match &remaps[k] {
+                Some(remap) => {
+                    let used = remap.iter().filter(|&&r| r != u32::MAX).count();
+                    (
+                        remap_stream(&d.positions, remap, used),
+                        remap_stream(&d.normals, remap, used),
+                    )
+                }
+                None => (d.positions, d.normals),
+            };
+            out[k].push(TargetSurface { positions, normals });
+        }
+    }
+    out
+}
+
+/// The joined mesh displaced by target `t` (a primitive without that target stays put).
+fn displaced(mesh: &TriMesh, prepared: &[Prepared], t: usize) -> TriMesh {
+    let mut moved = mesh.clone();
+    for p in prepared {
+        let Some(target) = p.data.targets.get(t) else {
+            continue;
+        };
+        let offset = p.vertex_offset as usize;
+        for a in target {
+            let (Values::Float(d), 3) = (&a.values, a.components) else {
+                continue;
+            };
+            let slots = moved.positions.len().min(offset + d.len() / 3);
+            for (v, c) in (offset..slots).zip(d.chunks_exact(3)) {
+                let delta = DVec3::new(c[0].into(), c[1].into(), c[2].into());
+                match a.name.as_str() {
+                    "POSITION" => moved.positions[v] += delta,
+                    "NORMAL" => {
+                        let n = (mesh.normals[v] + delta).normalize_or_zero();
+                        if n != DVec3::ZERO {
+                            moved.normals[v] = n;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+    moved
+}

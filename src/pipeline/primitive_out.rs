@@ -1,0 +1,386 @@
+//! Builds a replacement primitive from a dense mesh: positions and exact normals from the
+//! surface, every other attribute carried by its rule, tangents regenerated, morph targets as
+//! deltas.
+//!
+//! It deliberately decides only *which* rule an attribute follows (by its name and type); the
+//! rules themselves live in [`crate::attributes`] and [`crate::tangents`].
+
+use glam::DVec3;
+
+use super::morph::TargetSurface;
+use crate::attributes::{self, Carry, FloatAttribute, Skin, SourceTriangles};
+use crate::gltf_io::{Attribute, PrimitiveData, Values};
+use crate::normals::GeneratedNormals;
+use crate::tangents;
+use crate::tessellate::DenseMesh;
+use gltf_json::accessor::ComponentType;
+
+/// A primitive ready for the surface: its arrays (vertices split where generated normals
+/// required it), its unit normals, and its place in the joined mesh.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// The primitive's attributes and morph targets, indexed like `positions`.
+    pub data: PrimitiveData,
+    /// Positions in f64.
+    pub positions: Vec<DVec3>,
+    /// Unit normals in f64 (input, repaired, or generated).
+    pub normals: Vec<DVec3>,
+    /// Triangles over `positions`.
+    pub triangles: Vec<[u32; 3]>,
+    /// The input NORMAL values where they were already unit length, kept bit for bit at the
+    /// corners of the output (so level 1 with h = 0 reproduces the input exactly).
+    pub exact_normals: Option<Vec<[f32; 3]>>,
+    /// First vertex of this primitive in the joined mesh.
+    pub vertex_offset: u32,
+    /// Vertices the input had (before any split).
+    pub source_vertex_count: usize,
+    /// `Some(texcoord set)` when tangents are to be generated.
+    pub needs_tangents: Option<u32>,
+}
+
+impl Prepared {
+    /// A primitive whose normals came with it (possibly repaired).
+    pub fn new(
+        data: PrimitiveData,
+        positions: Vec<DVec3>,
+        normals: Vec<DVec3>,
+        triangles: Vec<[u32; 3]>,
+        needs_tangents: Option<u32>,
+    ) -> Self {
+        let exact_normals = data.attribute("NORMAL").and_then(|a| match &a.values {
+            Values::Float(v) if a.components == 3 => Some(
+                v.chunks_exact(3)
+                    .map(|c| [c[0], c[1], c[2]])
+                    .collect::<Vec<_>>(),
+            ),
+            _ => None,
+        });
+        let source_vertex_count = positions.len();
+        Prepared {
+            data,
+            positions,
+            normals,
+            triangles,
+            exact_normals,
+            vertex_offset: 0,
+            source_vertex_count,
+            needs_tangents,
+        }
+    }
+
+    /// A primitive that had no normals: every attribute and target follows the vertex split of
+    /// the generated normals.
+    pub fn with_generated_normals(
+        data: &PrimitiveData,
+        positions: &[DVec3],
+        generated: GeneratedNormals,
+        needs_tangents: Option<u32>,
+    ) -> Self {
+        let map = &generated.source_vertex;
+        let split = |a: &Attribute| -> Attribute {
+            let c = a.components.max(1);
+            let values = match &a.values {
+                Values::Float(v) => Values::Float(
+                    map.iter()
+                        .flat_map(|&s| v[s as usize * c..s as usize * c + c].iter().copied())
+                        .collect(),
+                ),
+                Values::Uint(v) => Values::Uint(
+                    map.iter()
+                        .flat_map(|&s| v[s as usize * c..s as usize * c + c].iter().copied())
+                        .collect(),
+                ),
+            };
+            Attribute {
+                values,
+                ..a.clone()
+            }
+        };
+        let data = PrimitiveData {
+            attributes: data.attributes.iter().map(split).collect(),
+            indices: generated.triangles.iter().flatten().copied().collect(),
+            targets: data
+                .targets
+                .iter()
+                .map(|t| t.iter().map(split).collect())
+                .collect(),
+        };
+        Prepared {
+            data,
+            positions: map.iter().map(|&s| positions[s as usize]).collect(),
+            normals: generated.normals,
+            triangles: generated.triangles,
+            exact_normals: None,
+            vertex_offset: 0,
+            source_vertex_count: positions.len(),
+            needs_tangents,
+        }
+    }
+
+    /// Vertices after any split.
+    pub fn vertex_count(&self) -> u32 {
+        self.positions.len() as u32
+    }
+}
+
+/// Whether a float attribute holds identifiers that must come from one corner, never blended.
+fn is_id_like(name: &str) -> bool {
+    name.starts_with("_FEATURE_ID_") || name == "_ID" || name == "_BATCHID"
+}
+
+fn float_attribute(name: &str, components: usize, values: Vec<f32>) -> Attribute {
+    Attribute {
+        name: name.to_string(),
+        components,
+        values: Values::Float(values),
+        component_type: ComponentType::F32,
+        normalized: false,
+    }
+}
+
+/// The replacement primitive for `prep`, from its dense mesh `dense` (whose sources refer to
+/// whole-mesh triangle `first_tri` onwards) and its re-evaluated morph targets.
+pub fn build(
+    prep: &Prepared,
+    dense: &DenseMesh,
+    first_tri: u32,
+    targets: Vec<TargetSurface>,
+) -> PrimitiveData {
+    let tris = SourceTriangles {
+        triangles: &prep.triangles,
+        first_tri,
+    };
+    let positions: Vec<f32> = dense.positions.iter().flatten().copied().collect();
+    let normals = corner_exact_normals(prep, dense, tris);
+    let flat_normals: Vec<f32> = normals.iter().flatten().copied().collect();
+
+    let mut attributes = Vec::with_capacity(prep.data.attributes.len() + 2);
+    let mut skin = Skin::default();
+    let mut skin_sets: Vec<(String, String)> = Vec::new();
+    for a in &prep.data.attributes {
+        match a.name.as_str() {
+            "POSITION" => attributes.push(float_attribute("POSITION", 3, positions.clone())),
+            "NORMAL" => attributes.push(float_attribute("NORMAL", 3, flat_normals.clone())),
+            "TANGENT" => {} // regenerated below
+            name if name.starts_with("JOINTS_") => {
+                let set = &name["JOINTS_".len()..];
+                let weights = format!("WEIGHTS_{set}");
+                if let (Values::Uint(j), Some(w)) = (&a.values, prep.data.attribute(&weights)) {
+                    if let Values::Float(w) = &w.values {
+                        if a.components == 4 && w.len() == j.len() {
+                            skin.joints.push(
+                                j.chunks_exact(4)
+                                    .map(|c| [c[0], c[1], c[2], c[3]])
+                                    .collect(),
+                            );
+                            skin.weights.push(
+                                w.chunks_exact(4)
+                                    .map(|c| [c[0], c[1], c[2], c[3]])
+                                    .collect(),
+                            );
+                            skin_sets.push((name.to_string(), weights));
+                            continue;
+                        }
+                    }
+                }
+                attributes.push(carry_one(a, tris, dense));
+            }
+            name if name.starts_with("WEIGHTS_") && skin_sets_has(prep, name) => {}
+            _ => attributes.push(carry_one(a, tris, dense)),
+        }
+    }
+    if prep.data.attribute("NORMAL").is_none() {
+        attributes.insert(
+            1.min(attributes.len()),
+            float_attribute("NORMAL", 3, flat_normals),
+        );
+    }
+    if !skin_sets.is_empty() {
+        let carried = attributes::carry_skin(&skin, tris, &dense.sources);
+        for (set, (joints_name, weights_name)) in skin_sets.iter().enumerate() {
+            let source = prep.data.attribute(joints_name).expect("found above");
+            attributes.push(Attribute {
+                name: joints_name.clone(),
+                components: 4,
+                values: Values::Uint(carried.joints[set].iter().flatten().copied().collect()),
+                component_type: source.component_type,
+                normalized: false,
+            });
+            attributes.push(float_attribute(
+                weights_name,
+                4,
+                carried.weights[set].iter().flatten().copied().collect(),
+            ));
+        }
+    }
+    let uv_of = |set: u32| -> Option<Vec<[f32; 2]>> {
+        let name = format!("TEXCOORD_{set}");
+        attributes
+            .iter()
+            .find(|a| a.name == name)
+            .and_then(|a| match &a.values {
+                Values::Float(v) if a.components == 2 => {
+                    Some(v.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+                }
+                _ => None,
+            })
+    };
+    let uvs = prep.needs_tangents.and_then(uv_of);
+    let base_tangents = uvs
+        .as_ref()
+        .map(|uv| tangents::generate(&dense.positions, &normals, uv, &dense.indices));
+    if let Some(t) = &base_tangents {
+        attributes.push(float_attribute(
+            "TANGENT",
+            4,
+            t.iter().flatten().copied().collect(),
+        ));
+    }
+
+    let targets = prep
+        .data
+        .targets
+        .iter()
+        .zip(targets)
+        .map(|(input, surface)| {
+            target_attributes(
+                input,
+                &surface,
+                dense,
+                &normals,
+                tris,
+                uvs.as_deref(),
+                base_tangents.as_deref(),
+            )
+        })
+        .collect();
+    PrimitiveData {
+        attributes,
+        indices: dense.indices.clone(),
+        targets,
+    }
+}
+
+fn skin_sets_has(prep: &Prepared, weights_name: &str) -> bool {
+    let joints = format!("JOINTS_{}", &weights_name["WEIGHTS_".len()..]);
+    matches!(prep.data.attribute(&joints), Some(a) if matches!(a.values, Values::Uint(_)) && a.components == 4)
+}
+
+/// Carries one attribute by the rule its name and type call for: integers and ID-like floats
+/// from the nearest corner, every other float interpolated.
+fn carry_one(a: &Attribute, tris: SourceTriangles<'_>, dense: &DenseMesh) -> Attribute {
+    match &a.values {
+        Values::Uint(v) => {
+            // Integers go through the nearest corner directly, with no float round trip.
+            let c = a.components.max(1);
+            let out: Vec<u32> = dense
+                .sources
+                .iter()
+                .flat_map(|s| {
+                    let t = tris.triangles[(s.tri - tris.first_tri) as usize];
+                    let k = t[attributes::nearest_corner(s.bary)] as usize;
+                    v[k * c..k * c + c].iter().copied()
+                })
+                .collect();
+            Attribute {
+                values: Values::Uint(out),
+                ..a.clone()
+            }
+        }
+        Values::Float(v) => {
+            let rule = if is_id_like(&a.name) {
+                Carry::NearestCorner
+            } else {
+                Carry::Interpolate
+            };
+            let source = FloatAttribute {
+                components: a.components,
+                values: v.clone(),
+            };
+            let carried = attributes::carry(&source, rule, tris, &dense.sources);
+            float_attribute(&a.name, a.components, carried.values)
+        }
+    }
+}
+
+/// Surface normals, except at the source triangle's corners, where the input's own unit normal
+/// is kept bit for bit.
+fn corner_exact_normals(
+    prep: &Prepared,
+    dense: &DenseMesh,
+    tris: SourceTriangles<'_>,
+) -> Vec<[f32; 3]> {
+    let Some(exact) = &prep.exact_normals else {
+        return dense.normals.clone();
+    };
+    dense
+        .normals
+        .iter()
+        .zip(&dense.sources)
+        .map(|(n, s)| {
+            let Some(c) = s.bary.iter().position(|&b| b == 1.0) else {
+                return *n;
+            };
+            let v = tris.triangles[(s.tri - tris.first_tri) as usize][c] as usize;
+            let e = exact[v];
+            let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+            if (len - 1.0).abs() < 1e-6 {
+                e
+            } else {
+                *n
+            }
+        })
+        .collect()
+}
+
+/// One morph target of the output: POSITION and NORMAL deltas from the re-evaluated surface,
+/// TANGENT deltas from regenerated tangents, anything else carried like a vertex attribute.
+fn target_attributes(
+    input: &[Attribute],
+    surface: &TargetSurface,
+    dense: &DenseMesh,
+    base_normals: &[[f32; 3]],
+    tris: SourceTriangles<'_>,
+    uvs: Option<&[[f32; 2]]>,
+    base_tangents: Option<&[[f32; 4]]>,
+) -> Vec<Attribute> {
+    let delta = |a: &[[f32; 3]], b: &[[f32; 3]]| -> Vec<f32> {
+        a.iter()
+            .zip(b)
+            .flat_map(|(x, y)| [x[0] - y[0], x[1] - y[1], x[2] - y[2]])
+            .collect()
+    };
+    let mut out = Vec::with_capacity(input.len());
+    for a in input {
+        match a.name.as_str() {
+            "POSITION" => out.push(float_attribute(
+                "POSITION",
+                3,
+                delta(&surface.positions, &dense.positions),
+            )),
+            "NORMAL" => out.push(float_attribute(
+                "NORMAL",
+                3,
+                delta(&surface.normals, base_normals),
+            )),
+            "TANGENT" => {
+                if let (Some(uv), Some(base)) = (uvs, base_tangents) {
+                    let moved = tangents::generate(
+                        &surface.positions,
+                        &surface.normals,
+                        uv,
+                        &dense.indices,
+                    );
+                    let d: Vec<f32> = moved
+                        .iter()
+                        .zip(base)
+                        .flat_map(|(m, b)| [m[0] - b[0], m[1] - b[1], m[2] - b[2]])
+                        .collect();
+                    out.push(float_attribute("TANGENT", 3, d));
+                }
+            }
+            _ => out.push(carry_one(a, tris, dense)),
+        }
+    }
+    out
+}
