@@ -130,7 +130,7 @@ impl ConfigFile {
     /// Parses TOML text; `origin` names it in errors (`file.toml:12: …`).
     pub fn parse(text: &str, origin: &str) -> Result<Self, ConfigError> {
         toml::from_str(text).map_err(|e: toml::de::Error| {
-            let line = e.span().map(|s| text[..s.start].lines().count().max(1));
+            let line = e.span().map(|s| text[..s.start].matches('\n').count() + 1);
             ConfigError {
                 at: line.map_or(origin.to_string(), |l| format!("{origin}:{l}")),
                 what: e.message().to_lowercase(),
@@ -145,21 +145,43 @@ impl Options {
         macro_rules! take {
             ($($f:ident),*) => { $( if let Some(v) = config.$f { self.$f = v; } )* };
         }
-        take!(level, h, crease_angle, profile, scheme, max_output_triangles, allow_outside_uris, force, quantize, compress);
+        take!(
+            level,
+            h,
+            crease_angle,
+            profile,
+            scheme,
+            max_output_triangles,
+            allow_outside_uris,
+            force,
+            quantize,
+            compress
+        );
         self
     }
 
     /// Checks every range; `origin` names where the values came from.
     pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
-        let err = |key: &str, what: String| Err(ConfigError { at: format!("{origin}: {key}"), what });
+        let err = |key: &str, what: String| {
+            Err(ConfigError {
+                at: format!("{origin}: {key}"),
+                what,
+            })
+        };
         if !(1..=MAX_LEVEL).contains(&self.level) {
-            return err("level", format!("is {} (expected 1 to {MAX_LEVEL})", self.level));
+            return err(
+                "level",
+                format!("is {} (expected 1 to {MAX_LEVEL})", self.level),
+            );
         }
         if !(0.0..=MAX_H).contains(&self.h) {
             return err("h", format!("is {} (expected 0 to {MAX_H:.4})", self.h));
         }
         if !(0.0..=180.0).contains(&self.crease_angle) {
-            return err("crease_angle", format!("is {} (expected 0 to 180 degrees)", self.crease_angle));
+            return err(
+                "crease_angle",
+                format!("is {} (expected 0 to 180 degrees)", self.crease_angle),
+            );
         }
         if self.max_output_triangles == 0 {
             return err("max_output_triangles", "is 0 (expected at least 1)".into());
@@ -188,7 +210,14 @@ mod tests {
 
     #[test]
     fn out_of_range_h_is_refused() {
-        let o = Options::default().overlay(&ConfigFile { h: Some(1.7), ..Default::default() });
-        assert!(o.validate("--h").unwrap_err().what.contains("expected 0 to 0.3536"));
+        let o = Options::default().overlay(&ConfigFile {
+            h: Some(1.7),
+            ..Default::default()
+        });
+        assert!(o
+            .validate("--h")
+            .unwrap_err()
+            .what
+            .contains("expected 0 to 0.3536"));
     }
 }

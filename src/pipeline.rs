@@ -47,7 +47,11 @@ pub fn process_document(doc: &mut Document, options: &Options) -> Result<Report,
 }
 
 /// Reads `input`, processes it and writes `output`.
-pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<Report, gltf_io::Error> {
+pub fn process_file(
+    input: &Path,
+    output: &Path,
+    options: &Options,
+) -> Result<Report, gltf_io::Error> {
     let mut doc = gltf_io::read(input, &options.read_options())?;
     let report = process_document(&mut doc, options)?;
     let write = WriteOptions::new(Some(input.to_path_buf()), options.force);

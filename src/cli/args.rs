@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use clap::{Parser, ValueEnum};
-use g2tess::options::{self, ConfigFile, ConfigError, Options};
+use g2tess::options::{self, ConfigError, ConfigFile, Options};
 
 /// Turns low-poly glTF meshes into dense, watertight G²-smooth meshes with exact normals.
 ///

@@ -64,7 +64,9 @@ pub fn run() -> i32 {
 /// `name.glb` → `name.smooth.glb`.
 fn smooth_name(input: &Path) -> PathBuf {
     let stem = input.file_stem().unwrap_or_default().to_string_lossy();
-    let ext = input.extension().map_or("glb".into(), |e| e.to_string_lossy());
+    let ext = input
+        .extension()
+        .map_or("glb".into(), |e| e.to_string_lossy());
     input.with_file_name(format!("{stem}.smooth.{ext}"))
 }
 

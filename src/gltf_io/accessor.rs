@@ -90,7 +90,12 @@ pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
     let total = count
         .checked_mul(elem_packed as u64)
         .filter(|t| *t <= max_bytes)
-        .ok_or_else(|| Error::invalid(format!("{at}.count"), format!("{count} elements exceed the limit of {max_bytes} bytes")))?;
+        .ok_or_else(|| {
+            Error::invalid(
+                format!("{at}.count"),
+                format!("{count} elements exceed the limit of {max_bytes} bytes"),
+            )
+        })?;
     let count = count as usize;
     let mut bytes = Vec::new();
     match a.buffer_view {
@@ -127,14 +132,32 @@ pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
         let sat = format!("{at}.sparse");
         let n = sparse.count.0 as usize;
         if n as u64 > count as u64 {
-            return Err(Error::invalid(format!("{sat}.count"), format!("{n} exceeds the accessor's count {count}")));
+            return Err(Error::invalid(
+                format!("{sat}.count"),
+                format!("{n} exceeds the accessor's count {count}"),
+            ));
         }
         let Checked::Valid(ict) = &sparse.indices.component_type else {
-            return Err(Error::invalid(format!("{sat}.indices.componentType"), "invalid (expected 5121, 5123 or 5125)"));
+            return Err(Error::invalid(
+                format!("{sat}.indices.componentType"),
+                "invalid (expected 5121, 5123 or 5125)",
+            ));
         };
         let isize = component_size(ict.0);
-        let idata = sparse_slice(doc, sparse.indices.buffer_view.value(), sparse.indices.byte_offset.0, n * isize, &format!("{sat}.indices"))?;
-        let vdata = sparse_slice(doc, sparse.values.buffer_view.value(), sparse.values.byte_offset.0, n * elem_stored, &format!("{sat}.values"))?;
+        let idata = sparse_slice(
+            doc,
+            sparse.indices.buffer_view.value(),
+            sparse.indices.byte_offset.0,
+            n * isize,
+            &format!("{sat}.indices"),
+        )?;
+        let vdata = sparse_slice(
+            doc,
+            sparse.values.buffer_view.value(),
+            sparse.values.byte_offset.0,
+            n * elem_stored,
+            &format!("{sat}.values"),
+        )?;
         let mut previous = None;
         for k in 0..n {
             let target = read_uint(&idata[k * isize..], ict.0) as usize;
@@ -162,11 +185,23 @@ pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
     })
 }
 
-fn sparse_slice<'a>(doc: &'a Document, view: usize, offset: u64, len: usize, at: &str) -> Result<&'a [u8]> {
+fn sparse_slice<'a>(
+    doc: &'a Document,
+    view: usize,
+    offset: u64,
+    len: usize,
+    at: &str,
+) -> Result<&'a [u8]> {
     let data = doc.view_bytes(view)?;
     let start = offset as usize;
     data.get(start..start.saturating_add(len)).ok_or_else(|| {
-        Error::invalid(at, format!("{len} bytes at offset {offset} do not fit in bufferViews[{view}] of {} bytes", data.len()))
+        Error::invalid(
+            at,
+            format!(
+                "{len} bytes at offset {offset} do not fit in bufferViews[{view}] of {} bytes",
+                data.len()
+            ),
+        )
     })
 }
 
@@ -221,7 +256,9 @@ impl Accessor {
             (true, ComponentType::U16) => 65535.0,
             (true, _) => 4294967295.0,
         };
-        (0..self.len()).map(|i| ((self.raw(i) / scale).max(-1.0)) as f32).collect()
+        (0..self.len())
+            .map(|i| ((self.raw(i) / scale).max(-1.0)) as f32)
+            .collect()
     }
 
     /// Every component as `u32` (for indices, joints and integer IDs).

@@ -67,16 +67,29 @@ pub struct Document {
 /// Reads the asset at `path` (`.gltf` or `.glb`, told apart by content).
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Document> {
     let shown = path.display().to_string();
-    let len = std::fs::metadata(path).map_err(|e| Error::io(&shown, e))?.len();
+    let len = std::fs::metadata(path)
+        .map_err(|e| Error::io(&shown, e))?
+        .len();
     if len > opts.max_bytes {
-        return Err(Error::invalid(shown, format!("file is {len} bytes (expected at most {})", opts.max_bytes)));
+        return Err(Error::invalid(
+            shown,
+            format!("file is {len} bytes (expected at most {})", opts.max_bytes),
+        ));
     }
     let bytes = std::fs::read(path).map_err(|e| Error::io(&shown, e))?;
-    let named_glb = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let named_glb = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     if named_glb && !bytes.starts_with(b"{") {
         glb::split(&bytes)?; // a .glb that is not JSON either: report its header
     }
-    let dir = path.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p });
+    let dir = path.parent().map(|p| {
+        if p.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            p
+        }
+    });
     read_bytes(&bytes, dir, opts)
 }
 
@@ -90,12 +103,16 @@ pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> 
         (bytes, None)
     };
     if json.starts_with(&[0xEF, 0xBB, 0xBF]) {
-        return Err(Error::invalid("json", "starts with a utf-8 byte order mark, which glTF forbids (expected '{')"));
+        return Err(Error::invalid(
+            "json",
+            "starts with a utf-8 byte order mark, which glTF forbids (expected '{')",
+        ));
     }
-    let raw: Value = serde_json::from_slice(json).map_err(|e| Error::invalid("json", e.to_string().to_lowercase()))?;
+    let raw: Value = serde_json::from_slice(json)
+        .map_err(|e| Error::invalid("json", e.to_string().to_lowercase()))?;
     check_version(&raw)?;
-    let root: gltf_json::Root =
-        serde_json::from_value(typed_shim(&raw)).map_err(|e| Error::invalid("json", e.to_string().to_lowercase()))?;
+    let root: gltf_json::Root = serde_json::from_value(typed_shim(&raw))
+        .map_err(|e| Error::invalid("json", e.to_string().to_lowercase()))?;
     validate::primitive_references(&root)?;
     check_typed(&root)?;
     validate::structure(&root, &raw)?;
@@ -123,7 +140,12 @@ pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> 
 /// in (`scenes[].nodes`), so that valid files parse. The merge on write drops them again.
 fn typed_shim(raw: &Value) -> Value {
     let mut v = raw.clone();
-    for scene in v.get_mut("scenes").and_then(Value::as_array_mut).into_iter().flatten() {
+    for scene in v
+        .get_mut("scenes")
+        .and_then(Value::as_array_mut)
+        .into_iter()
+        .flatten()
+    {
         if let Some(obj) = scene.as_object_mut() {
             obj.entry("nodes").or_insert_with(|| Value::Array(vec![]));
         }
@@ -134,18 +156,32 @@ fn typed_shim(raw: &Value) -> Value {
 /// Refuses anything but glTF 2.x, with a message that names glTF 1.0 when it is that.
 fn check_version(raw: &Value) -> Result<()> {
     let Some(obj) = raw.as_object() else {
-        return Err(Error::invalid("json", "the top level is not an object (expected a glTF object)"));
+        return Err(Error::invalid(
+            "json",
+            "the top level is not an object (expected a glTF object)",
+        ));
     };
     let version = obj
         .get("asset")
-        .ok_or_else(|| Error::invalid("asset", "missing (expected an asset object with version \"2.0\")"))?
+        .ok_or_else(|| {
+            Error::invalid(
+                "asset",
+                "missing (expected an asset object with version \"2.0\")",
+            )
+        })?
         .get("version")
         .and_then(Value::as_str)
         .ok_or_else(|| Error::invalid("asset.version", "missing (expected \"2.0\")"))?;
     match version.split('.').next() {
         Some("2") => Ok(()),
-        Some("1") => Err(Error::unsupported("asset.version", format!("glTF {version} is not supported (expected 2.0)"))),
-        _ => Err(Error::invalid("asset.version", format!("{version:?} is not a glTF version (expected \"2.0\")"))),
+        Some("1") => Err(Error::unsupported(
+            "asset.version",
+            format!("glTF {version} is not supported (expected 2.0)"),
+        )),
+        _ => Err(Error::invalid(
+            "asset.version",
+            format!("{version:?} is not a glTF version (expected \"2.0\")"),
+        )),
     }
 }
 
@@ -153,27 +189,37 @@ fn check_version(raw: &Value) -> Result<()> {
 /// its refusal of required extensions it does not know: those are carried through.
 fn check_typed(root: &gltf_json::Root) -> Result<()> {
     let mut first = None;
-    root.validate(root, gltf_json::Path::new, &mut |path: &dyn Fn() -> gltf_json::Path, err| {
-        use gltf_json::validation::Error as E;
-        if first.is_some() || err == E::Unsupported {
-            return;
-        }
-        // The spec lets accessors omit bufferView (they read as zeros); gltf-json does not.
-        let p = path();
-        // Likewise texture.source, which extensions such as KHR_texture_basisu replace.
-        let optional = [("accessors[", "].bufferView"), ("textures[", "].source")];
-        if err == E::Missing && optional.iter().any(|(a, b)| p.as_str().starts_with(a) && p.as_str().ends_with(b)) {
-            return;
-        }
-        let what = match err {
-            E::IndexOutOfBounds => "refers to an object that does not exist (expected an index in range)",
-            E::Invalid => "has a value the glTF specification does not allow",
-            E::Missing => "is missing (expected it by the glTF specification)",
-            E::Oversize => "is larger than this system can address",
-            E::Unsupported => unreachable!(),
-        };
-        first = Some(Error::invalid(path().as_str(), what));
-    });
+    root.validate(
+        root,
+        gltf_json::Path::new,
+        &mut |path: &dyn Fn() -> gltf_json::Path, err| {
+            use gltf_json::validation::Error as E;
+            if first.is_some() || err == E::Unsupported {
+                return;
+            }
+            // The spec lets accessors omit bufferView (they read as zeros); gltf-json does not.
+            let p = path();
+            // Likewise texture.source, which extensions such as KHR_texture_basisu replace.
+            let optional = [("accessors[", "].bufferView"), ("textures[", "].source")];
+            if err == E::Missing
+                && optional
+                    .iter()
+                    .any(|(a, b)| p.as_str().starts_with(a) && p.as_str().ends_with(b))
+            {
+                return;
+            }
+            let what = match err {
+                E::IndexOutOfBounds => {
+                    "refers to an object that does not exist (expected an index in range)"
+                }
+                E::Invalid => "has a value the glTF specification does not allow",
+                E::Missing => "is missing (expected it by the glTF specification)",
+                E::Oversize => "is larger than this system can address",
+                E::Unsupported => unreachable!(),
+            };
+            first = Some(Error::invalid(path().as_str(), what));
+        },
+    );
     match first {
         Some(e) => Err(e),
         None => Ok(()),
@@ -192,21 +238,41 @@ fn load_buffers(
         let at = format!("buffers[{i}]");
         let declared = buffer.byte_length.0;
         if declared > opts.max_bytes {
-            return Err(Error::invalid(&at, format!("byteLength {declared} exceeds the limit of {} bytes", opts.max_bytes)));
+            return Err(Error::invalid(
+                &at,
+                format!(
+                    "byteLength {declared} exceeds the limit of {} bytes",
+                    opts.max_bytes
+                ),
+            ));
         }
         let data = match (&buffer.uri, bin) {
             (Some(u), _) => {
-                let data = uri::load(u, &format!("{at}.uri"), base_dir, opts.allow_outside_uris, opts.max_bytes)?;
+                let data = uri::load(
+                    u,
+                    &format!("{at}.uri"),
+                    base_dir,
+                    opts.allow_outside_uris,
+                    opts.max_bytes,
+                )?;
                 if u.starts_with("data:") && data.len() as u64 != declared {
                     return Err(Error::invalid(
                         format!("{at}.byteLength"),
-                        format!("is {declared} but the data: uri holds {} bytes (expected equal)", data.len()),
+                        format!(
+                            "is {declared} but the data: uri holds {} bytes (expected equal)",
+                            data.len()
+                        ),
                     ));
                 }
                 data
             }
             (None, Some(bin)) if i == 0 => bin.to_vec(),
-            (None, _) if meshopt_decode::is_fallback(buffer) || meshopt_decode::only_compressed_views(root, i) => Vec::new(),
+            (None, _)
+                if meshopt_decode::is_fallback(buffer)
+                    || meshopt_decode::only_compressed_views(root, i) =>
+            {
+                Vec::new()
+            }
             (None, _) => {
                 return Err(Error::invalid(
                     format!("{at}.uri"),
@@ -240,13 +306,21 @@ impl Document {
         data.get(start..end).ok_or_else(|| {
             Error::invalid(
                 format!("bufferViews[{view}]"),
-                format!("bytes {start}..{end} are not in its buffer of {} bytes", data.len()),
+                format!(
+                    "bytes {start}..{end} are not in its buffer of {} bytes",
+                    data.len()
+                ),
             )
         })
     }
 
     /// Appends `bytes` as a new buffer view in the document's scratch buffer; returns its index.
-    pub(crate) fn push_view(&mut self, bytes: &[u8], stride: Option<usize>, target: Option<gltf_json::buffer::Target>) -> usize {
+    pub(crate) fn push_view(
+        &mut self,
+        bytes: &[u8],
+        stride: Option<usize>,
+        target: Option<gltf_json::buffer::Target>,
+    ) -> usize {
         let scratch = self.scratch_buffer();
         let data = &mut self.buffers[scratch];
         while data.len() % 4 != 0 {
@@ -271,7 +345,12 @@ impl Document {
     /// The in-memory buffer that new views go into, created on first use.
     fn scratch_buffer(&mut self) -> usize {
         const NAME: &str = "g2tess scratch";
-        if let Some(i) = self.root.buffers.iter().position(|b| b.name.as_deref() == Some(NAME) && b.uri.is_none()) {
+        if let Some(i) = self
+            .root
+            .buffers
+            .iter()
+            .position(|b| b.name.as_deref() == Some(NAME) && b.uri.is_none())
+        {
             return i;
         }
         self.root.buffers.push(gltf_json::Buffer {

@@ -46,13 +46,19 @@ pub fn split(bytes: &[u8]) -> Result<Chunks<'_>> {
         ));
     }
     if version != 2 {
-        return Err(Error::invalid("glb header", format!("version is {version} (expected 2)")));
+        return Err(Error::invalid(
+            "glb header",
+            format!("version is {version} (expected 2)"),
+        ));
     }
     let length = u32_at(bytes, 8) as usize;
     if length != bytes.len() {
         return Err(Error::invalid(
             "glb header",
-            format!("declared length {length} differs from the file size {} (expected equal)", bytes.len()),
+            format!(
+                "declared length {length} differs from the file size {} (expected equal)",
+                bytes.len()
+            ),
         ));
     }
     let mut json = None;
@@ -70,19 +76,38 @@ pub fn split(bytes: &[u8]) -> Result<Chunks<'_>> {
         if len > bytes.len() - start {
             return Err(Error::invalid(
                 name,
-                format!("chunk length {len} runs past the end of the file ({} bytes left)", bytes.len() - start),
+                format!(
+                    "chunk length {len} runs past the end of the file ({} bytes left)",
+                    bytes.len() - start
+                ),
             ));
         }
         if len % 4 != 0 {
-            return Err(Error::invalid(name, format!("chunk length {len} is not a multiple of 4")));
+            return Err(Error::invalid(
+                name,
+                format!("chunk length {len} is not a multiple of 4"),
+            ));
         }
         let data = &bytes[start..start + len];
         match (index, kind) {
             (0, CHUNK_JSON) => json = Some(data),
-            (0, _) => return Err(Error::invalid(name, "the first chunk is not JSON (expected a JSON chunk first)")),
+            (0, _) => {
+                return Err(Error::invalid(
+                    name,
+                    "the first chunk is not JSON (expected a JSON chunk first)",
+                ))
+            }
             (1, CHUNK_BIN) => bin = Some(data),
-            (_, CHUNK_JSON) => return Err(Error::invalid(name, "a second JSON chunk (expected exactly one)")),
-            (_, CHUNK_BIN) => return Err(Error::invalid(name, "a BIN chunk after the second position (expected at most one, right after JSON)")),
+            (_, CHUNK_JSON) => {
+                return Err(Error::invalid(
+                    name,
+                    "a second JSON chunk (expected exactly one)",
+                ))
+            }
+            (_, CHUNK_BIN) => return Err(Error::invalid(
+                name,
+                "a BIN chunk after the second position (expected at most one, right after JSON)",
+            )),
             _ => {} // unknown chunk types must be ignored
         }
         at = start + len;

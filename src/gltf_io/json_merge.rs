@@ -14,15 +14,29 @@ pub fn merge(base: &Value, now: &Value, raw: &Value) -> Value {
         return raw.clone();
     }
     match (base, now, raw) {
-        (Value::Object(b), Value::Object(n), Value::Object(r)) => Value::Object(merge_objects(b, n, r)),
-        (Value::Array(b), Value::Array(n), Value::Array(r)) if b.len() == n.len() && n.len() == r.len() => {
-            Value::Array(b.iter().zip(n).zip(r).map(|((b, n), r)| merge(b, n, r)).collect())
+        (Value::Object(b), Value::Object(n), Value::Object(r)) => {
+            Value::Object(merge_objects(b, n, r))
+        }
+        (Value::Array(b), Value::Array(n), Value::Array(r))
+            if b.len() == n.len() && n.len() == r.len() =>
+        {
+            Value::Array(
+                b.iter()
+                    .zip(n)
+                    .zip(r)
+                    .map(|((b, n), r)| merge(b, n, r))
+                    .collect(),
+            )
         }
         _ => now.clone(),
     }
 }
 
-fn merge_objects(b: &Map<String, Value>, n: &Map<String, Value>, r: &Map<String, Value>) -> Map<String, Value> {
+fn merge_objects(
+    b: &Map<String, Value>,
+    n: &Map<String, Value>,
+    r: &Map<String, Value>,
+) -> Map<String, Value> {
     let mut out = Map::new();
     for (key, raw) in r {
         match (b.get(key), n.get(key)) {
@@ -58,7 +72,10 @@ mod tests {
         let raw = json!({"a": 0.1, "unknown": 1, "b": [1, 2]});
         let base = json!({"a": 0.100000001, "b": [1, 2]});
         let now = json!({"a": 0.100000001, "b": [1, 3]});
-        assert_eq!(merge(&base, &now, &raw), json!({"a": 0.1, "unknown": 1, "b": [1, 3]}));
+        assert_eq!(
+            merge(&base, &now, &raw),
+            json!({"a": 0.1, "unknown": 1, "b": [1, 3]})
+        );
     }
 
     #[test]

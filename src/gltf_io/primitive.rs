@@ -86,15 +86,21 @@ impl PrimitiveData {
 }
 
 fn index_of(v: &Value, at: &str) -> Result<usize> {
-    v.as_u64().map(|i| i as usize).ok_or_else(|| Error::invalid(at, "is not an index"))
+    v.as_u64()
+        .map(|i| i as usize)
+        .ok_or_else(|| Error::invalid(at, "is not an index"))
 }
 
 impl Document {
     /// The JSON of a primitive as it will be written (replaced or as read).
     pub(crate) fn primitive_json(&self, mesh: usize, prim: usize) -> Option<&Value> {
-        self.replaced
-            .get(&(mesh, prim))
-            .or_else(|| self.raw.get("meshes")?.get(mesh)?.get("primitives")?.get(prim))
+        self.replaced.get(&(mesh, prim)).or_else(|| {
+            self.raw
+                .get("meshes")?
+                .get(mesh)?
+                .get("primitives")?
+                .get(prim)
+        })
     }
 
     /// Every (mesh, primitive) whose mode is a triangle list, strip or fan, in file order.
@@ -117,15 +123,25 @@ impl Document {
             .primitive_json(mesh, prim)
             .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
         if let Some(ext) = json.get("extensions").and_then(Value::as_object) {
-            if let Some(name) = ext.keys().find(|k| k.as_str() == "KHR_draco_mesh_compression") {
+            if let Some(name) = ext
+                .keys()
+                .find(|k| k.as_str() == "KHR_draco_mesh_compression")
+            {
                 return Err(Error::unsupported(
                     format!("{at}.extensions.{name}"),
                     "draco-compressed geometry cannot be decoded by this tool (expected uncompressed or meshopt-compressed data)",
                 ));
             }
         }
-        let max = ReadOptions::DEFAULT_MAX_BYTES.max(self.buffers.iter().map(|b| b.len() as u64).sum());
-        let attributes = read_attributes(self, json.get("attributes"), &format!("{at}.attributes"), false, max)?;
+        let max =
+            ReadOptions::DEFAULT_MAX_BYTES.max(self.buffers.iter().map(|b| b.len() as u64).sum());
+        let attributes = read_attributes(
+            self,
+            json.get("attributes"),
+            &format!("{at}.attributes"),
+            false,
+            max,
+        )?;
         let vertices = attributes.first().map_or(0, Attribute::count);
         let list: Vec<u32> = match json.get("indices") {
             Some(i) => accessor::read(self, index_of(i, &format!("{at}.indices"))?, max)?.to_u32(),
@@ -140,30 +156,66 @@ impl Document {
                     [list[i], list[i + 1 + odd], list[i + 2 - odd]]
                 })
                 .collect(),
-            6 => (1..list.len().saturating_sub(1)).flat_map(|i| [list[i], list[i + 1], list[0]]).collect(),
+            6 => (1..list.len().saturating_sub(1))
+                .flat_map(|i| [list[i], list[i + 1], list[0]])
+                .collect(),
             other => {
-                return Err(Error::invalid(format!("{at}.mode"), format!("{other} is not a triangle mode (expected 4, 5 or 6)")))
+                return Err(Error::invalid(
+                    format!("{at}.mode"),
+                    format!("{other} is not a triangle mode (expected 4, 5 or 6)"),
+                ))
             }
         };
         let mut targets = Vec::new();
-        for (t, target) in json.get("targets").and_then(Value::as_array).into_iter().flatten().enumerate() {
-            targets.push(read_attributes(self, Some(target), &format!("{at}.targets[{t}]"), true, max)?);
+        for (t, target) in json
+            .get("targets")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .enumerate()
+        {
+            targets.push(read_attributes(
+                self,
+                Some(target),
+                &format!("{at}.targets[{t}]"),
+                true,
+                max,
+            )?);
         }
-        Ok(PrimitiveData { attributes, indices, targets })
+        Ok(PrimitiveData {
+            attributes,
+            indices,
+            targets,
+        })
     }
 }
 
 /// Decodes an `attributes` (or morph target) object.
-fn read_attributes(doc: &Document, obj: Option<&Value>, at: &str, target: bool, max: u64) -> Result<Vec<Attribute>> {
+fn read_attributes(
+    doc: &Document,
+    obj: Option<&Value>,
+    at: &str,
+    target: bool,
+    max: u64,
+) -> Result<Vec<Attribute>> {
     let Some(obj) = obj.and_then(Value::as_object) else {
         return Err(Error::invalid(at, "is not an object of accessor indices"));
     };
     let mut out = Vec::with_capacity(obj.len());
     for (name, index) in obj {
         let acc = accessor::read(doc, index_of(index, &format!("{at}.{name}"))?, max)?;
-        let unsigned_int = !acc.normalized && matches!(acc.component_type, ComponentType::U8 | ComponentType::U16 | ComponentType::U32);
-        let integer = !target && unsigned_int && (name.starts_with("JOINTS_") || name.starts_with('_'));
-        let values = if integer { Values::Uint(acc.to_u32()) } else { Values::Float(acc.to_f32()) };
+        let unsigned_int = !acc.normalized
+            && matches!(
+                acc.component_type,
+                ComponentType::U8 | ComponentType::U16 | ComponentType::U32
+            );
+        let integer =
+            !target && unsigned_int && (name.starts_with("JOINTS_") || name.starts_with('_'));
+        let values = if integer {
+            Values::Uint(acc.to_u32())
+        } else {
+            Values::Float(acc.to_f32())
+        };
         out.push(Attribute {
             name: name.clone(),
             components: acc.components,
@@ -177,7 +229,12 @@ fn read_attributes(doc: &Document, obj: Option<&Value>, at: &str, target: bool, 
 
 /// Replaces primitive `prim` of mesh `mesh` by `data`: new accessors (with min/max), mode
 /// TRIANGLES; material, extensions, extras and any other property of the primitive are kept.
-pub fn replace_primitive(doc: &mut Document, mesh: usize, prim: usize, data: &PrimitiveData) -> Result<()> {
+pub fn replace_primitive(
+    doc: &mut Document,
+    mesh: usize,
+    prim: usize,
+    data: &PrimitiveData,
+) -> Result<()> {
     let at = format!("meshes[{mesh}].primitives[{prim}]");
     let mut json = doc
         .primitive_json(mesh, prim)
@@ -186,12 +243,18 @@ pub fn replace_primitive(doc: &mut Document, mesh: usize, prim: usize, data: &Pr
     collect_accessor_refs(&json, &mut doc.replaced_accessors);
     let vertices = data.vertex_count();
     if let Some(bad) = data.indices.iter().find(|i| **i as usize >= vertices) {
-        return Err(Error::invalid(&at, format!("new index {bad} is not below the vertex count {vertices}")));
+        return Err(Error::invalid(
+            &at,
+            format!("new index {bad} is not below the vertex count {vertices}"),
+        ));
     }
     let mut attributes = Map::new();
     for a in &data.attributes {
         if a.count() != vertices {
-            return Err(Error::invalid(format!("{at}.attributes.{}", a.name), format!("has {} vertices (expected {vertices})", a.count())));
+            return Err(Error::invalid(
+                format!("{at}.attributes.{}", a.name),
+                format!("has {} vertices (expected {vertices})", a.count()),
+            ));
         }
         attributes.insert(a.name.clone(), json!(push_attribute(doc, a)));
     }
@@ -204,7 +267,9 @@ pub fn replace_primitive(doc: &mut Document, mesh: usize, prim: usize, data: &Pr
         targets.push(Value::Object(obj));
     }
     let indices = push_indices(doc, &data.indices, vertices);
-    let obj = json.as_object_mut().ok_or_else(|| Error::invalid(&at, "is not an object"))?;
+    let obj = json
+        .as_object_mut()
+        .ok_or_else(|| Error::invalid(&at, "is not an object"))?;
     obj.insert("attributes".into(), Value::Object(attributes));
     obj.insert("indices".into(), json!(indices));
     if obj.contains_key("mode") {
@@ -227,7 +292,11 @@ pub fn replace_primitive(doc: &mut Document, mesh: usize, prim: usize, data: &Pr
 
 /// Adds every accessor index `prim` refers to (attributes, indices, targets) to `out`.
 pub(crate) fn collect_accessor_refs(prim: &Value, out: &mut std::collections::BTreeSet<usize>) {
-    let attrs = prim.get("attributes").and_then(Value::as_object).into_iter().flat_map(|o| o.values());
+    let attrs = prim
+        .get("attributes")
+        .and_then(Value::as_object)
+        .into_iter()
+        .flat_map(|o| o.values());
     let targets = prim
         .get("targets")
         .and_then(Value::as_array)
@@ -245,64 +314,123 @@ pub(crate) fn collect_accessor_refs(prim: &Value, out: &mut std::collections::BT
 /// Writes one attribute as a new accessor; floats as FLOAT, integers in their original type.
 fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
     let n = a.components.max(1);
-    let (ct, mut bytes, min, max): (ComponentType, Vec<u8>, Vec<Value>, Vec<Value>) = match &a.values {
-        Values::Float(v) => {
-            let (mut lo, mut hi) = (vec![f32::INFINITY; n], vec![f32::NEG_INFINITY; n]);
-            for (k, x) in v.iter().enumerate() {
-                lo[k % n] = lo[k % n].min(*x);
-                hi[k % n] = hi[k % n].max(*x);
+    let (ct, mut bytes, min, max): (ComponentType, Vec<u8>, Vec<Value>, Vec<Value>) =
+        match &a.values {
+            Values::Float(v) => {
+                let (mut lo, mut hi) = (vec![f32::INFINITY; n], vec![f32::NEG_INFINITY; n]);
+                for (k, x) in v.iter().enumerate() {
+                    lo[k % n] = lo[k % n].min(*x);
+                    hi[k % n] = hi[k % n].max(*x);
+                }
+                let bytes = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+                (
+                    ComponentType::F32,
+                    bytes,
+                    lo.iter().map(|x| json!(*x)).collect(),
+                    hi.iter().map(|x| json!(*x)).collect(),
+                )
             }
-            let bytes = v.iter().flat_map(|x| x.to_le_bytes()).collect();
-            (ComponentType::F32, bytes, lo.iter().map(|x| json!(*x)).collect(), hi.iter().map(|x| json!(*x)).collect())
-        }
-        Values::Uint(v) => {
-            let ct = match a.component_type {
-                ComponentType::U8 => ComponentType::U8,
-                ComponentType::U16 => ComponentType::U16,
-                _ => ComponentType::U32,
-            };
-            let (mut lo, mut hi) = (vec![u32::MAX; n], vec![0u32; n]);
-            for (k, x) in v.iter().enumerate() {
-                lo[k % n] = lo[k % n].min(*x);
-                hi[k % n] = hi[k % n].max(*x);
+            Values::Uint(v) => {
+                let ct = match a.component_type {
+                    ComponentType::U8 => ComponentType::U8,
+                    ComponentType::U16 => ComponentType::U16,
+                    _ => ComponentType::U32,
+                };
+                let (mut lo, mut hi) = (vec![u32::MAX; n], vec![0u32; n]);
+                for (k, x) in v.iter().enumerate() {
+                    lo[k % n] = lo[k % n].min(*x);
+                    hi[k % n] = hi[k % n].max(*x);
+                }
+                let bytes = v
+                    .iter()
+                    .flat_map(|x| match ct {
+                        ComponentType::U8 => vec![*x as u8],
+                        ComponentType::U16 => (*x as u16).to_le_bytes().to_vec(),
+                        _ => x.to_le_bytes().to_vec(),
+                    })
+                    .collect();
+                (
+                    ct,
+                    bytes,
+                    lo.iter().map(|x| json!(*x)).collect(),
+                    hi.iter().map(|x| json!(*x)).collect(),
+                )
             }
-            let bytes = v
-                .iter()
-                .flat_map(|x| match ct {
-                    ComponentType::U8 => vec![*x as u8],
-                    ComponentType::U16 => (*x as u16).to_le_bytes().to_vec(),
-                    _ => x.to_le_bytes().to_vec(),
-                })
-                .collect();
-            (ct, bytes, lo.iter().map(|x| json!(*x)).collect(), hi.iter().map(|x| json!(*x)).collect())
-        }
-    };
+        };
     // Vertex attribute elements must start on 4-byte boundaries: pad them when they are shorter.
     let elem = n * component_size(ct);
     let stride = elem.div_ceil(4) * 4;
     if stride != elem {
-        bytes = bytes.chunks(elem).flat_map(|e| e.iter().copied().chain(std::iter::repeat_n(0, stride - elem))).collect();
+        bytes = bytes
+            .chunks(elem)
+            .flat_map(|e| {
+                e.iter()
+                    .copied()
+                    .chain(std::iter::repeat_n(0, stride - elem))
+            })
+            .collect();
     }
     let count = a.count();
-    let view = doc.push_view(&bytes, (stride != elem).then_some(stride), Some(gltf_json::buffer::Target::ArrayBuffer));
+    let view = doc.push_view(
+        &bytes,
+        (stride != elem).then_some(stride),
+        Some(gltf_json::buffer::Target::ArrayBuffer),
+    );
     let bounds = count > 0;
-    push_accessor(doc, view, count, ct, vector_type(n), bounds.then(|| Value::Array(min)), bounds.then(|| Value::Array(max)))
+    push_accessor(
+        doc,
+        view,
+        count,
+        ct,
+        vector_type(n),
+        bounds.then(|| Value::Array(min)),
+        bounds.then(|| Value::Array(max)),
+    )
 }
 
 /// Writes a triangle list as u16 indices when they fit (65535 is the restart value), else u32.
 fn push_indices(doc: &mut Document, indices: &[u32], vertices: usize) -> usize {
     let (ct, bytes): (ComponentType, Vec<u8>) = if vertices <= 65535 {
-        (ComponentType::U16, indices.iter().flat_map(|i| (*i as u16).to_le_bytes()).collect())
+        (
+            ComponentType::U16,
+            indices
+                .iter()
+                .flat_map(|i| (*i as u16).to_le_bytes())
+                .collect(),
+        )
     } else {
-        (ComponentType::U32, indices.iter().flat_map(|i| i.to_le_bytes()).collect())
+        (
+            ComponentType::U32,
+            indices.iter().flat_map(|i| i.to_le_bytes()).collect(),
+        )
     };
-    let view = doc.push_view(&bytes, None, Some(gltf_json::buffer::Target::ElementArrayBuffer));
+    let view = doc.push_view(
+        &bytes,
+        None,
+        Some(gltf_json::buffer::Target::ElementArrayBuffer),
+    );
     let (lo, hi) = (indices.iter().min(), indices.iter().max());
     let bounds = lo.zip(hi).map(|(l, h)| (json!([l]), json!([h])));
-    push_accessor(doc, view, indices.len(), ct, Type::Scalar, bounds.as_ref().map(|b| b.0.clone()), bounds.map(|b| b.1))
+    push_accessor(
+        doc,
+        view,
+        indices.len(),
+        ct,
+        Type::Scalar,
+        bounds.as_ref().map(|b| b.0.clone()),
+        bounds.map(|b| b.1),
+    )
 }
 
-fn push_accessor(doc: &mut Document, view: usize, count: usize, ct: ComponentType, ty: Type, min: Option<Value>, max: Option<Value>) -> usize {
+fn push_accessor(
+    doc: &mut Document,
+    view: usize,
+    count: usize,
+    ct: ComponentType,
+    ty: Type,
+    min: Option<Value>,
+    max: Option<Value>,
+) -> usize {
     doc.root.accessors.push(gltf_json::Accessor {
         buffer_view: Some(gltf_json::Index::new(view as u32)),
         byte_offset: None,

@@ -23,14 +23,20 @@ pub enum Target {
 /// Classifies and checks `uri` (found at JSON path `at`) relative to `base_dir`.
 ///
 /// Percent-decoding happens here because exporters write both `%20` and literal spaces.
-pub fn resolve(uri: &str, at: &str, base_dir: Option<&Path>, allow_outside: bool) -> Result<Target> {
+pub fn resolve(
+    uri: &str,
+    at: &str,
+    base_dir: Option<&Path>,
+    allow_outside: bool,
+) -> Result<Target> {
     if let Some(rest) = uri.strip_prefix("data:") {
         return decode_data_uri(rest, at).map(Target::Data);
     }
-    let scheme = uri
-        .split_once(':')
-        .map(|(s, _)| s)
-        .filter(|s| s.len() > 1 && s.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c)));
+    let scheme = uri.split_once(':').map(|(s, _)| s).filter(|s| {
+        s.len() > 1
+            && s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
+    });
     let local = match scheme {
         Some(s) if s.eq_ignore_ascii_case("file") && allow_outside => {
             uri[5..].trim_start_matches("//").to_string()
@@ -45,12 +51,20 @@ pub fn resolve(uri: &str, at: &str, base_dir: Option<&Path>, allow_outside: bool
     };
     let decoded = percent_encoding::percent_decode_str(&local)
         .decode_utf8()
-        .map_err(|_| Error::invalid(at, format!("uri {uri:?} is not valid utf-8 after percent-decoding")))?;
+        .map_err(|_| {
+            Error::invalid(
+                at,
+                format!("uri {uri:?} is not valid utf-8 after percent-decoding"),
+            )
+        })?;
     let rel = Path::new(decoded.as_ref());
     let escapes = rel.is_absolute()
-        || rel
-            .components()
-            .any(|c| matches!(c, Component::ParentDir | Component::RootDir | Component::Prefix(_)));
+        || rel.components().any(|c| {
+            matches!(
+                c,
+                Component::ParentDir | Component::RootDir | Component::Prefix(_)
+            )
+        });
     if escapes && !allow_outside {
         return Err(Error::invalid(
             at,
@@ -67,14 +81,25 @@ pub fn resolve(uri: &str, at: &str, base_dir: Option<&Path>, allow_outside: bool
 }
 
 /// Reads the bytes `uri` points at, refusing files larger than `max_bytes` before reading them.
-pub fn load(uri: &str, at: &str, base_dir: Option<&Path>, allow_outside: bool, max_bytes: u64) -> Result<Vec<u8>> {
+pub fn load(
+    uri: &str,
+    at: &str,
+    base_dir: Option<&Path>,
+    allow_outside: bool,
+    max_bytes: u64,
+) -> Result<Vec<u8>> {
     match resolve(uri, at, base_dir, allow_outside)? {
         Target::Data(bytes) => Ok(bytes),
         Target::File(path) => {
             let shown = format!("{at} ({})", path.display());
-            let len = std::fs::metadata(&path).map_err(|e| Error::io(&shown, e))?.len();
+            let len = std::fs::metadata(&path)
+                .map_err(|e| Error::io(&shown, e))?
+                .len();
             if len > max_bytes {
-                return Err(Error::invalid(shown, format!("file is {len} bytes (expected at most {max_bytes})")));
+                return Err(Error::invalid(
+                    shown,
+                    format!("file is {len} bytes (expected at most {max_bytes})"),
+                ));
             }
             std::fs::read(&path).map_err(|e| Error::io(shown, e))
         }
@@ -112,20 +137,38 @@ mod tests {
 
     #[test]
     fn network_schemes_are_never_fetched() {
-        let err = resolve("http://example.com/b.bin", "buffers[0].uri", Some(Path::new(".")), true).unwrap_err();
+        let err = resolve(
+            "http://example.com/b.bin",
+            "buffers[0].uri",
+            Some(Path::new(".")),
+            true,
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("http: scheme"), "{err}");
         assert!(resolve("file:///etc/passwd", "b", Some(Path::new(".")), false).is_err());
     }
 
     #[test]
     fn percent_encoded_names_are_decoded() {
-        let t = resolve("Unicode%20%E2%9D%A4 Binary.bin", "b", Some(Path::new("d")), false).unwrap();
+        let t = resolve(
+            "Unicode%20%E2%9D%A4 Binary.bin",
+            "b",
+            Some(Path::new("d")),
+            false,
+        )
+        .unwrap();
         assert_eq!(t, Target::File(Path::new("d").join("Unicode ❤ Binary.bin")));
     }
 
     #[test]
     fn data_uris_decode_base64() {
-        let t = resolve("data:application/octet-stream;base64,AAEC", "b", None, false).unwrap();
+        let t = resolve(
+            "data:application/octet-stream;base64,AAEC",
+            "b",
+            None,
+            false,
+        )
+        .unwrap();
         assert_eq!(t, Target::Data(vec![0, 1, 2]));
     }
 }

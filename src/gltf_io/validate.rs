@@ -24,7 +24,10 @@ const WEIGHT_SUM_TOLERANCE: f64 = 0.02;
 
 /// Is `mode` one the tool replaces with a triangle list?
 pub fn is_triangle_mode(mode: &Checked<Mode>) -> bool {
-    matches!(mode, Checked::Valid(Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan))
+    matches!(
+        mode,
+        Checked::Valid(Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
+    )
 }
 
 /// Every index a primitive holds points at an existing accessor. `gltf-json`'s own validation
@@ -38,7 +41,10 @@ pub fn primitive_references(root: &gltf_json::Root) -> Result<()> {
                 if a.value() >= n {
                     return Err(Error::invalid(
                         format!("{at}.attributes.{}", semantic_name(sem)),
-                        format!("refers to accessor {} but there are {n} (expected an index in range)", a.value()),
+                        format!(
+                            "refers to accessor {} but there are {n} (expected an index in range)",
+                            a.value()
+                        ),
                     ));
                 }
             }
@@ -59,14 +65,19 @@ pub fn structure(root: &gltf_json::Root, _raw: &Value) -> Result<()> {
     }
     nodes(root)?;
     for (m, mesh) in root.meshes.iter().enumerate() {
-        let targets = mesh.primitives.first().map_or(0, |p| p.targets.as_ref().map_or(0, Vec::len));
+        let targets = mesh
+            .primitives
+            .first()
+            .map_or(0, |p| p.targets.as_ref().map_or(0, Vec::len));
         for (p, prim) in mesh.primitives.iter().enumerate() {
             let at = format!("meshes[{m}].primitives[{p}]");
             let n = prim.targets.as_ref().map_or(0, Vec::len);
             if n != targets {
                 return Err(Error::invalid(
                     format!("{at}.targets"),
-                    format!("{n} morph targets (expected {targets}, as in the mesh's first primitive)"),
+                    format!(
+                        "{n} morph targets (expected {targets}, as in the mesh's first primitive)"
+                    ),
                 ));
             }
             primitive_formats(root, prim, &at)?;
@@ -75,7 +86,10 @@ pub fn structure(root: &gltf_json::Root, _raw: &Value) -> Result<()> {
             if w.len() != targets {
                 return Err(Error::invalid(
                     format!("meshes[{m}].weights"),
-                    format!("has {} entries (expected one per morph target: {targets})", w.len()),
+                    format!(
+                        "has {} entries (expected one per morph target: {targets})",
+                        w.len()
+                    ),
                 ));
             }
         }
@@ -93,7 +107,9 @@ fn nodes(root: &gltf_json::Root) -> Result<()> {
             if let Some(p) = parent[c] {
                 return Err(Error::invalid(
                     format!("nodes[{i}].children"),
-                    format!("node {c} is already a child of node {p} (expected one parent per node)"),
+                    format!(
+                        "node {c} is already a child of node {p} (expected one parent per node)"
+                    ),
                 ));
             }
             parent[c] = Some(i);
@@ -118,7 +134,10 @@ fn nodes(root: &gltf_json::Root) -> Result<()> {
             at = p;
             steps += 1;
             if p == start || steps > n {
-                return Err(Error::invalid(format!("nodes[{start}]"), "is its own ancestor (expected a tree of nodes)"));
+                return Err(Error::invalid(
+                    format!("nodes[{start}]"),
+                    "is its own ancestor (expected a tree of nodes)",
+                ));
             }
         }
     }
@@ -134,8 +153,15 @@ fn semantic_name(s: &Checked<Semantic>) -> String {
 
 /// Attribute sets are numbered from 0 without gaps; formats are the ones the spec (with
 /// KHR_mesh_quantization where required) allows; counts agree.
-fn primitive_formats(root: &gltf_json::Root, prim: &gltf_json::mesh::Primitive, at: &str) -> Result<()> {
-    let quantized = root.extensions_required.iter().any(|e| e == "KHR_mesh_quantization");
+fn primitive_formats(
+    root: &gltf_json::Root,
+    prim: &gltf_json::mesh::Primitive,
+    at: &str,
+) -> Result<()> {
+    let quantized = root
+        .extensions_required
+        .iter()
+        .any(|e| e == "KHR_mesh_quantization");
     let mut sets: BTreeMap<&str, BTreeSet<u32>> = BTreeMap::new();
     let mut count = None;
     for (sem, index) in &prim.attributes {
@@ -143,11 +169,16 @@ fn primitive_formats(root: &gltf_json::Root, prim: &gltf_json::mesh::Primitive, 
         let aat = format!("{at}.attributes.{name}");
         let a = &root.accessors[index.value()];
         let (Checked::Valid(ct), Checked::Valid(ty)) = (&a.component_type, &a.type_) else {
-            return Err(Error::invalid(aat, "accessor has an invalid componentType or type"));
+            return Err(Error::invalid(
+                aat,
+                "accessor has an invalid componentType or type",
+            ));
         };
         check_format(sem, ct.0, *ty, a.normalized, quantized, false, &aat)?;
         match sem {
-            Checked::Valid(Semantic::TexCoords(n)) => sets.entry("TEXCOORD").or_default().insert(*n),
+            Checked::Valid(Semantic::TexCoords(n)) => {
+                sets.entry("TEXCOORD").or_default().insert(*n)
+            }
             Checked::Valid(Semantic::Colors(n)) => sets.entry("COLOR").or_default().insert(*n),
             Checked::Valid(Semantic::Joints(n)) => sets.entry("JOINTS").or_default().insert(*n),
             Checked::Valid(Semantic::Weights(n)) => sets.entry("WEIGHTS").or_default().insert(*n),
@@ -158,7 +189,10 @@ fn primitive_formats(root: &gltf_json::Root, prim: &gltf_json::mesh::Primitive, 
             Some((c, ref first)) if c != a.count.0 => {
                 return Err(Error::invalid(
                     aat,
-                    format!("has {} elements but {first} has {c} (expected equal counts)", a.count.0),
+                    format!(
+                        "has {} elements but {first} has {c} (expected equal counts)",
+                        a.count.0
+                    ),
                 ))
             }
             _ => {}
@@ -168,12 +202,18 @@ fn primitive_formats(root: &gltf_json::Root, prim: &gltf_json::mesh::Primitive, 
         if let Some(missing) = (0..set.len() as u32).find(|n| !set.contains(n)) {
             return Err(Error::invalid(
                 format!("{at}.attributes"),
-                format!("has {kind}_{} but no {kind}_{missing} (expected sets numbered from 0)", set.iter().max().unwrap()),
+                format!(
+                    "has {kind}_{} but no {kind}_{missing} (expected sets numbered from 0)",
+                    set.iter().max().unwrap()
+                ),
             ));
         }
     }
     if sets.get("JOINTS") != sets.get("WEIGHTS") {
-        return Err(Error::invalid(format!("{at}.attributes"), "JOINTS_n and WEIGHTS_n sets do not pair up (expected one WEIGHTS_n per JOINTS_n)"));
+        return Err(Error::invalid(
+            format!("{at}.attributes"),
+            "JOINTS_n and WEIGHTS_n sets do not pair up (expected one WEIGHTS_n per JOINTS_n)",
+        ));
     }
     for (t, target) in prim.targets.iter().flatten().enumerate() {
         let list = [
@@ -186,12 +226,29 @@ fn primitive_formats(root: &gltf_json::Root, prim: &gltf_json::mesh::Primitive, 
             let aat = format!("{at}.targets[{t}].{}", sem.to_string());
             let a = &root.accessors[index.value()];
             let (Checked::Valid(ct), Checked::Valid(ty)) = (&a.component_type, &a.type_) else {
-                return Err(Error::invalid(aat, "accessor has an invalid componentType or type"));
+                return Err(Error::invalid(
+                    aat,
+                    "accessor has an invalid componentType or type",
+                ));
             };
-            check_format(&Checked::Valid(sem), ct.0, *ty, a.normalized, quantized, true, &aat)?;
+            check_format(
+                &Checked::Valid(sem),
+                ct.0,
+                *ty,
+                a.normalized,
+                quantized,
+                true,
+                &aat,
+            )?;
             if let Some((c, first)) = &count {
                 if *c != a.count.0 {
-                    return Err(Error::invalid(aat, format!("has {} elements but {first} has {c} (expected equal counts)", a.count.0)));
+                    return Err(Error::invalid(
+                        aat,
+                        format!(
+                            "has {} elements but {first} has {c} (expected equal counts)",
+                            a.count.0
+                        ),
+                    ));
                 }
             }
         }
@@ -207,20 +264,43 @@ fn primitive_formats(root: &gltf_json::Root, prim: &gltf_json::mesh::Primitive, 
         }
     }
     if is_triangle_mode(&prim.mode) {
-        if !prim.attributes.contains_key(&Checked::Valid(Semantic::Positions)) {
-            return Err(Error::invalid(format!("{at}.attributes"), "a triangle primitive has no POSITION (expected a VEC3 POSITION accessor)"));
+        if !prim
+            .attributes
+            .contains_key(&Checked::Valid(Semantic::Positions))
+        {
+            return Err(Error::invalid(
+                format!("{at}.attributes"),
+                "a triangle primitive has no POSITION (expected a VEC3 POSITION accessor)",
+            ));
         }
-        let n = prim.indices.map_or(vertices.unwrap_or(0), |i| root.accessors[i.value()].count.0);
+        let n = prim
+            .indices
+            .map_or(vertices.unwrap_or(0), |i| root.accessors[i.value()].count.0);
         if matches!(prim.mode, Checked::Valid(Mode::Triangles)) && n % 3 != 0 {
-            let what = if prim.indices.is_some() { "indices" } else { "vertices" };
-            return Err(Error::invalid(at, format!("{n} {what} do not form whole triangles (expected a multiple of 3)")));
+            let what = if prim.indices.is_some() {
+                "indices"
+            } else {
+                "vertices"
+            };
+            return Err(Error::invalid(
+                at,
+                format!("{n} {what} do not form whole triangles (expected a multiple of 3)"),
+            ));
         }
     }
     Ok(())
 }
 
 /// The component formats the spec allows per semantic; KHR_mesh_quantization widens them.
-fn check_format(sem: &Checked<Semantic>, ct: ComponentType, ty: Type, normalized: bool, quantized: bool, target: bool, at: &str) -> Result<()> {
+fn check_format(
+    sem: &Checked<Semantic>,
+    ct: ComponentType,
+    ty: Type,
+    normalized: bool,
+    quantized: bool,
+    target: bool,
+    at: &str,
+) -> Result<()> {
     use ComponentType as C;
     let float = ct == C::F32;
     let unorm = normalized && matches!(ct, C::U8 | C::U16);
@@ -238,7 +318,10 @@ fn check_format(sem: &Checked<Semantic>, ct: ComponentType, ty: Type, normalized
         Checked::Invalid => return Err(Error::invalid(at, "is not a glTF attribute semantic (expected POSITION, NORMAL, TANGENT, TEXCOORD_n, COLOR_n, JOINTS_n, WEIGHTS_n or a name starting with _)")),
     };
     if !types.contains(&ty) {
-        return Err(Error::invalid(at, format!("accessor type is {ty:?} (expected {types:?})")));
+        return Err(Error::invalid(
+            at,
+            format!("accessor type is {ty:?} (expected {types:?})"),
+        ));
     }
     if core || (widened && quantized) {
         return Ok(());
@@ -249,7 +332,10 @@ fn check_format(sem: &Checked<Semantic>, ct: ComponentType, ty: Type, normalized
             format!("componentType {ct:?} (normalized: {normalized}) needs KHR_mesh_quantization (expected it in extensionsRequired)"),
         ));
     }
-    Err(Error::invalid(at, format!("componentType {ct:?} (normalized: {normalized}) is not allowed for this semantic")))
+    Err(Error::invalid(
+        at,
+        format!("componentType {ct:?} (normalized: {normalized}) is not allowed for this semantic"),
+    ))
 }
 
 /// Buffer views lie inside their buffers and have legal strides.
@@ -257,10 +343,15 @@ pub fn buffer_views(root: &gltf_json::Root, buffers: &[Vec<u8>]) -> Result<()> {
     for (i, v) in root.buffer_views.iter().enumerate() {
         let at = format!("bufferViews[{i}]");
         let b = v.buffer.value();
-        let end = v.byte_offset.map_or(0, |o| o.0).checked_add(v.byte_length.0);
+        let end = v
+            .byte_offset
+            .map_or(0, |o| o.0)
+            .checked_add(v.byte_length.0);
         let declared = root.buffers[b].byte_length.0;
         let compressed = v.extensions.as_ref().is_some_and(|e| {
-            super::meshopt_decode::EXTENSIONS.iter().any(|n| e.others.contains_key(*n))
+            super::meshopt_decode::EXTENSIONS
+                .iter()
+                .any(|n| e.others.contains_key(*n))
         });
         if end.is_none_or(|e| e > declared || (!compressed && e > buffers[b].len() as u64)) {
             return Err(Error::invalid(
@@ -270,12 +361,18 @@ pub fn buffer_views(root: &gltf_json::Root, buffers: &[Vec<u8>]) -> Result<()> {
         }
         if let Some(s) = v.byte_stride {
             if s.0 < 4 || s.0 > 252 || s.0 % 4 != 0 {
-                return Err(Error::invalid(format!("{at}.byteStride"), format!("{} (expected a multiple of 4 from 4 to 252)", s.0)));
+                return Err(Error::invalid(
+                    format!("{at}.byteStride"),
+                    format!("{} (expected a multiple of 4 from 4 to 252)", s.0),
+                ));
             }
             if s.0 as u64 > v.byte_length.0 {
                 return Err(Error::invalid(
                     format!("{at}.byteStride"),
-                    format!("{} is larger than the view's byteLength {} (expected a stride that fits)", s.0, v.byte_length.0),
+                    format!(
+                        "{} is larger than the view's byteLength {} (expected a stride that fits)",
+                        s.0, v.byte_length.0
+                    ),
                 ));
             }
         }
@@ -291,8 +388,19 @@ fn carried_accessors(root: &gltf_json::Root) -> Vec<bool> {
     for mesh in &root.meshes {
         for prim in &mesh.primitives {
             let tri = is_triangle_mode(&prim.mode);
-            let targets = prim.targets.iter().flatten().flat_map(|t| [t.positions, t.normals, t.tangents]).flatten();
-            for a in prim.attributes.values().copied().chain(prim.indices).chain(targets) {
+            let targets = prim
+                .targets
+                .iter()
+                .flatten()
+                .flat_map(|t| [t.positions, t.normals, t.tangents])
+                .flatten();
+            for a in prim
+                .attributes
+                .values()
+                .copied()
+                .chain(prim.indices)
+                .chain(targets)
+            {
                 if tri {
                     carried[a.value()] = false;
                 } else {
@@ -301,7 +409,11 @@ fn carried_accessors(root: &gltf_json::Root) -> Vec<bool> {
             }
         }
     }
-    carried.iter().zip(&other_use).map(|(c, o)| *c || *o).collect()
+    carried
+        .iter()
+        .zip(&other_use)
+        .map(|(c, o)| *c || *o)
+        .collect()
 }
 
 /// Data checks: finite floats, bounds arrays of the right length (and equal to the data where
@@ -315,7 +427,14 @@ pub fn data(doc: &Document, max_bytes: u64) -> Result<()> {
         let acc = accessor::read(doc, i, max_bytes)?;
         if acc.component_type == ComponentType::F32 {
             if let Some(k) = (0..acc.len()).find(|k| !acc.raw(*k).is_finite()) {
-                return Err(Error::invalid(&at, format!("element {} holds {} (expected finite numbers)", k / acc.components, acc.raw(k))));
+                return Err(Error::invalid(
+                    &at,
+                    format!(
+                        "element {} holds {} (expected finite numbers)",
+                        k / acc.components,
+                        acc.raw(k)
+                    ),
+                ));
             }
         }
         check_bounds(a, &acc, carried[i], &at)?;
@@ -325,11 +444,18 @@ pub fn data(doc: &Document, max_bytes: u64) -> Result<()> {
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
             let at = format!("meshes[{m}].primitives[{p}]");
-            let draco = prim.extensions.as_ref().is_some_and(|e| e.others.contains_key("KHR_draco_mesh_compression"));
+            let draco = prim
+                .extensions
+                .as_ref()
+                .is_some_and(|e| e.others.contains_key("KHR_draco_mesh_compression"));
             if draco {
                 continue; // its accessors are placeholders; reading the primitive reports Draco
             }
-            let vertices = prim.attributes.values().next().map_or(0, |a| get(a.value()).count);
+            let vertices = prim
+                .attributes
+                .values()
+                .next()
+                .map_or(0, |a| get(a.value()).count);
             if let Some(ix) = prim.indices {
                 let acc = get(ix.value());
                 let restart = match acc.component_type {
@@ -372,9 +498,18 @@ fn check_bounds(a: &gltf_json::Accessor, acc: &Accessor, carried: bool, at: &str
     }
     for (key, declared, actual) in [("min", &a.min, &actual_min), ("max", &a.max, &actual_max)] {
         let Some(declared) = declared else { continue };
-        let values: Option<Vec<f64>> = declared.as_array().map(|v| v.iter().map(Value::as_f64).collect()).unwrap_or(None);
+        let values: Option<Vec<f64>> = declared
+            .as_array()
+            .map(|v| v.iter().map(Value::as_f64).collect())
+            .unwrap_or(None);
         let Some(values) = values.filter(|v| v.len() == acc.components) else {
-            return Err(Error::invalid(format!("{at}.{key}"), format!("is not an array of {} numbers (expected one per component)", acc.components)));
+            return Err(Error::invalid(
+                format!("{at}.{key}"),
+                format!(
+                    "is not an array of {} numbers (expected one per component)",
+                    acc.components
+                ),
+            ));
         };
         // Zero-filled accessors are not checked (the Khronos validator does not either).
         let zero_filled = a.buffer_view.is_none() && a.sparse.is_none();
@@ -383,7 +518,11 @@ fn check_bounds(a: &gltf_json::Accessor, acc: &Accessor, carried: bool, at: &str
         }
         let float = acc.component_type == ComponentType::F32;
         for (c, (d, v)) in values.iter().zip(actual.iter()).enumerate() {
-            let same = if float { (*d as f32) == (*v as f32) } else { d == v };
+            let same = if float {
+                (*d as f32) == (*v as f32)
+            } else {
+                d == v
+            };
             if !same {
                 return Err(Error::invalid(
                     format!("{at}.{key}[{c}]"),
@@ -401,22 +540,38 @@ fn unit_vectors(acc: &Accessor, at: &str, tangent: bool) -> Result<()> {
     for (e, chunk) in v.chunks_exact(n).enumerate() {
         let len = (chunk[..3].iter().map(|x| (*x as f64).powi(2)).sum::<f64>()).sqrt();
         if (len - 1.0).abs() > UNIT_TOLERANCE {
-            return Err(Error::invalid(at, format!("element {e} has length {len:.4} (expected a unit vector)")));
+            return Err(Error::invalid(
+                at,
+                format!("element {e} has length {len:.4} (expected a unit vector)"),
+            ));
         }
         if tangent && n == 4 && chunk[3].abs() != 1.0 {
-            return Err(Error::invalid(at, format!("element {e} has w = {} (expected 1 or -1)", chunk[3])));
+            return Err(Error::invalid(
+                at,
+                format!("element {e} has w = {} (expected 1 or -1)", chunk[3]),
+            ));
         }
     }
     Ok(())
 }
 
 /// Joint indices exist in every skin the mesh is used with; weights are non-negative and sum to 1.
-fn skin_data<'a>(doc: &Document, mesh: usize, prim: &gltf_json::mesh::Primitive, at: &str, get: &dyn Fn(usize) -> &'a Accessor) -> Result<()>
+fn skin_data<'a>(
+    doc: &Document,
+    mesh: usize,
+    prim: &gltf_json::mesh::Primitive,
+    at: &str,
+    get: &dyn Fn(usize) -> &'a Accessor,
+) -> Result<()>
 where
 {
     let root = &doc.root;
-    let joints: Vec<_> = (0..).map_while(|n| prim.attributes.get(&Checked::Valid(Semantic::Joints(n)))).collect();
-    let weights: Vec<_> = (0..).map_while(|n| prim.attributes.get(&Checked::Valid(Semantic::Weights(n)))).collect();
+    let joints: Vec<_> = (0..)
+        .map_while(|n| prim.attributes.get(&Checked::Valid(Semantic::Joints(n))))
+        .collect();
+    let weights: Vec<_> = (0..)
+        .map_while(|n| prim.attributes.get(&Checked::Valid(Semantic::Weights(n))))
+        .collect();
     if weights.is_empty() {
         return Ok(());
     }
@@ -428,13 +583,19 @@ where
             for c in 0..4 {
                 let x = w[v * 4 + c] as f64;
                 if x < 0.0 {
-                    return Err(Error::invalid(format!("{at}.attributes.WEIGHTS_{set}"), format!("vertex {v} has a negative weight {x} (expected weights >= 0)")));
+                    return Err(Error::invalid(
+                        format!("{at}.attributes.WEIGHTS_{set}"),
+                        format!("vertex {v} has a negative weight {x} (expected weights >= 0)"),
+                    ));
                 }
                 sum += x;
             }
         }
         if (sum - 1.0).abs() > WEIGHT_SUM_TOLERANCE {
-            return Err(Error::invalid(format!("{at}.attributes.WEIGHTS_0"), format!("vertex {v}'s weights sum to {sum} (expected 1)")));
+            return Err(Error::invalid(
+                format!("{at}.attributes.WEIGHTS_0"),
+                format!("vertex {v}'s weights sum to {sum} (expected 1)"),
+            ));
         }
     }
     let skins: BTreeSet<usize> = root
@@ -446,7 +607,12 @@ where
     for skin in skins {
         let limit = root.skins[skin].joints.len() as u32;
         for (set, j) in joints.iter().enumerate() {
-            if let Some((k, bad)) = get(j.value()).to_u32().iter().enumerate().find(|(_, x)| **x >= limit) {
+            if let Some((k, bad)) = get(j.value())
+                .to_u32()
+                .iter()
+                .enumerate()
+                .find(|(_, x)| **x >= limit)
+            {
                 return Err(Error::invalid(
                     format!("{at}.attributes.JOINTS_{set}"),
                     format!("vertex {} uses joint {bad}, but skins[{skin}] has {limit} joints (expected a joint below {limit})", k / 4),

@@ -30,18 +30,29 @@ pub struct WriteOptions {
 impl WriteOptions {
     /// Options that refuse to overwrite `input` unless `overwrite_input` is set.
     pub fn new(input: Option<PathBuf>, overwrite_input: bool) -> Self {
-        Self { input, overwrite_input }
+        Self {
+            input,
+            overwrite_input,
+        }
     }
 }
 
 /// Writes `doc` to `path` (`.glb`, or `.gltf` + `<stem>.bin`).
 pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
     let shown = path.display().to_string();
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
     let as_glb = match ext.as_deref() {
         Some("glb") => true,
         Some("gltf") => false,
-        _ => return Err(Error::invalid(&shown, "output name must end in .glb or .gltf")),
+        _ => {
+            return Err(Error::invalid(
+                &shown,
+                "output name must end in .glb or .gltf",
+            ))
+        }
     };
     let bin_path = (!as_glb).then(|| path.with_extension("bin"));
     refuse_overwriting_input(doc, path, bin_path.as_deref(), opts)?;
@@ -81,14 +92,25 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 /// Refuses to replace the input, or a buffer or image file it refers to, unless forced.
-fn refuse_overwriting_input(doc: &Document, path: &Path, bin: Option<&Path>, opts: &WriteOptions) -> Result<()> {
+fn refuse_overwriting_input(
+    doc: &Document,
+    path: &Path,
+    bin: Option<&Path>,
+    opts: &WriteOptions,
+) -> Result<()> {
     if opts.overwrite_input {
         return Ok(());
     }
     let mut inputs: Vec<PathBuf> = opts.input.iter().cloned().collect();
     let uris = ["buffers", "images"]
         .iter()
-        .flat_map(|k| doc.raw.get(*k).and_then(Value::as_array).into_iter().flatten())
+        .flat_map(|k| {
+            doc.raw
+                .get(*k)
+                .and_then(Value::as_array)
+                .into_iter()
+                .flatten()
+        })
         .filter_map(|o| o.get("uri").and_then(Value::as_str));
     for u in uris {
         if let Ok(uri::Target::File(f)) = uri::resolve(u, "uri", doc.base_dir.as_deref(), true) {
@@ -99,7 +121,10 @@ fn refuse_overwriting_input(doc: &Document, path: &Path, bin: Option<&Path>, opt
         if let Some(input) = inputs.iter().find(|i| same_file(i, out)) {
             return Err(Error::invalid(
                 out.display(),
-                format!("would overwrite the input {} (pass --force to allow it)", input.display()),
+                format!(
+                    "would overwrite the input {} (pass --force to allow it)",
+                    input.display()
+                ),
             ));
         }
     }
@@ -109,9 +134,15 @@ fn refuse_overwriting_input(doc: &Document, path: &Path, bin: Option<&Path>, opt
 /// Writes `bytes` to a temporary file in `path`'s folder, then renames it over `path`.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
     let shown = path.display().to_string();
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".g2tess-")
-        .suffix(".tmp")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".g2tess-").suffix(".tmp");
+    // Temporary files are private (0600); the finished output gets the usual permissions.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder
         .tempfile_in(parent_dir(path))
         .map_err(|e| Error::io(&shown, e))?;
     tmp.write_all(bytes).map_err(|e| Error::io(&shown, e))?;
@@ -121,10 +152,16 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Builds the output JSON and its single binary buffer.
-fn assemble(doc: &Document, embed_images: bool, bin_path: Option<&Path>) -> Result<(Value, Vec<u8>)> {
+fn assemble(
+    doc: &Document,
+    embed_images: bool,
+    bin_path: Option<&Path>,
+) -> Result<(Value, Vec<u8>)> {
     let now = serde_json::to_value(&doc.root).map_err(|e| Error::invalid("json", e))?;
     let mut out = json_merge::merge(&doc.base, &now, &doc.raw);
-    let root = out.as_object_mut().ok_or_else(|| Error::invalid("json", "top level is not an object"))?;
+    let root = out
+        .as_object_mut()
+        .ok_or_else(|| Error::invalid("json", "top level is not an object"))?;
     for ((m, p), prim) in &doc.replaced {
         root["meshes"][*m]["primitives"][*p] = prim.clone();
     }
@@ -138,8 +175,15 @@ fn assemble(doc: &Document, embed_images: bool, bin_path: Option<&Path>) -> Resu
         .map(|i| referenced.contains(&i) || !doc.replaced_accessors.contains(&i))
         .collect();
     let accessor_views = |a: &gltf_json::Accessor| {
-        let sparse = a.sparse.iter().flat_map(|s| [s.indices.buffer_view.value(), s.values.buffer_view.value()]);
-        a.buffer_view.map(|v| v.value()).into_iter().chain(sparse).collect::<Vec<_>>()
+        let sparse = a
+            .sparse
+            .iter()
+            .flat_map(|s| [s.indices.buffer_view.value(), s.values.buffer_view.value()]);
+        a.buffer_view
+            .map(|v| v.value())
+            .into_iter()
+            .chain(sparse)
+            .collect::<Vec<_>>()
     };
     let mut view_used = vec![false; doc.root.buffer_views.len()];
     let mut view_orphaned = vec![false; doc.root.buffer_views.len()];
@@ -153,10 +197,18 @@ fn assemble(doc: &Document, embed_images: bool, bin_path: Option<&Path>) -> Resu
         }
     }
     for_each_view_ref(root, &mut |v| view_used[*v as usize] = true);
-    let keep_view: Vec<bool> = view_used.iter().zip(&view_orphaned).map(|(u, o)| *u || !*o).collect();
+    let keep_view: Vec<bool> = view_used
+        .iter()
+        .zip(&view_orphaned)
+        .map(|(u, o)| *u || !*o)
+        .collect();
 
     // Repack every kept view into one buffer.
-    let typed_views = now.get("bufferViews").and_then(Value::as_array).cloned().unwrap_or_default();
+    let typed_views = now
+        .get("bufferViews")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
     let mut bin = Vec::new();
     let mut views = Vec::new();
     let mut view_map = vec![None; keep_view.len()];
@@ -174,7 +226,11 @@ fn assemble(doc: &Document, embed_images: bool, bin_path: Option<&Path>) -> Resu
         view_map[i] = Some(views.len());
         views.push(v);
     }
-    let typed_accessors = now.get("accessors").and_then(Value::as_array).cloned().unwrap_or_default();
+    let typed_accessors = now
+        .get("accessors")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
     let mut accessors = Vec::new();
     let mut accessor_map = vec![None; keep_accessor.len()];
     for (i, keep) in keep_accessor.iter().enumerate() {
@@ -182,7 +238,11 @@ fn assemble(doc: &Document, embed_images: bool, bin_path: Option<&Path>) -> Resu
             continue;
         }
         let mut a = typed_accessors[i].clone();
-        for ptr in ["/bufferView", "/sparse/indices/bufferView", "/sparse/values/bufferView"] {
+        for ptr in [
+            "/bufferView",
+            "/sparse/indices/bufferView",
+            "/sparse/values/bufferView",
+        ] {
             if let Some(v) = a.pointer_mut(ptr) {
                 *v = json!(view_map[v.as_u64().unwrap_or(0) as usize]);
             }
@@ -190,8 +250,12 @@ fn assemble(doc: &Document, embed_images: bool, bin_path: Option<&Path>) -> Resu
         accessor_map[i] = Some(accessors.len());
         accessors.push(a);
     }
-    for_each_accessor_ref(root, &mut |i| *i = accessor_map[*i as usize].unwrap_or(0) as u64);
-    for_each_view_ref(root, &mut |v| *v = view_map[*v as usize].unwrap_or(0) as u64);
+    for_each_accessor_ref(root, &mut |i| {
+        *i = accessor_map[*i as usize].unwrap_or(0) as u64
+    });
+    for_each_view_ref(root, &mut |v| {
+        *v = view_map[*v as usize].unwrap_or(0) as u64
+    });
 
     if embed_images {
         embed_external_images(doc, root, &mut bin, &mut views)?;
@@ -215,8 +279,22 @@ fn assemble(doc: &Document, embed_images: bool, bin_path: Option<&Path>) -> Resu
 
 /// Characters escaped in a written file name `uri` (RFC 3986 reserved and unsafe ones).
 const URI_ESCAPES: &percent_encoding::AsciiSet = &percent_encoding::CONTROLS
-    .add(b' ').add(b'"').add(b'#').add(b'%').add(b'<').add(b'>').add(b'?').add(b'[').add(b'\\')
-    .add(b']').add(b'^').add(b'`').add(b'{').add(b'|').add(b'}').add(b':');
+    .add(b' ')
+    .add(b'"')
+    .add(b'#')
+    .add(b'%')
+    .add(b'<')
+    .add(b'>')
+    .add(b'?')
+    .add(b'[')
+    .add(b'\\')
+    .add(b']')
+    .add(b'^')
+    .add(b'`')
+    .add(b'{')
+    .add(b'|')
+    .add(b'}')
+    .add(b':');
 
 fn align4(bin: &mut Vec<u8>) {
     while bin.len() % 4 != 0 {
@@ -233,7 +311,10 @@ fn set_array(root: &mut Map<String, Value>, key: &str, items: Vec<Value>) {
 }
 
 fn arr<'a>(root: &'a mut Map<String, Value>, key: &str) -> impl Iterator<Item = &'a mut Value> {
-    root.get_mut(key).and_then(Value::as_array_mut).into_iter().flatten()
+    root.get_mut(key)
+        .and_then(Value::as_array_mut)
+        .into_iter()
+        .flatten()
 }
 
 fn visit_u64(v: Option<&mut Value>, f: &mut dyn FnMut(&mut u64)) {
@@ -246,7 +327,11 @@ fn visit_u64(v: Option<&mut Value>, f: &mut dyn FnMut(&mut u64)) {
 }
 
 fn visit_values(v: Option<&mut Value>, f: &mut dyn FnMut(&mut u64)) {
-    for x in v.and_then(Value::as_object_mut).into_iter().flat_map(|o| o.values_mut()) {
+    for x in v
+        .and_then(Value::as_object_mut)
+        .into_iter()
+        .flat_map(|o| o.values_mut())
+    {
         visit_u64(Some(x), f);
     }
 }
@@ -254,10 +339,20 @@ fn visit_values(v: Option<&mut Value>, f: &mut dyn FnMut(&mut u64)) {
 /// Calls `f` on every accessor index the JSON holds (in places this writer knows about).
 fn for_each_accessor_ref(root: &mut Map<String, Value>, f: &mut dyn FnMut(&mut u64)) {
     for mesh in arr(root, "meshes") {
-        for prim in mesh.get_mut("primitives").and_then(Value::as_array_mut).into_iter().flatten() {
+        for prim in mesh
+            .get_mut("primitives")
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
             visit_values(prim.get_mut("attributes"), f);
             visit_u64(prim.get_mut("indices"), f);
-            for t in prim.get_mut("targets").and_then(Value::as_array_mut).into_iter().flatten() {
+            for t in prim
+                .get_mut("targets")
+                .and_then(Value::as_array_mut)
+                .into_iter()
+                .flatten()
+            {
                 visit_values(Some(t), f);
             }
         }
@@ -266,13 +361,21 @@ fn for_each_accessor_ref(root: &mut Map<String, Value>, f: &mut dyn FnMut(&mut u
         visit_u64(skin.get_mut("inverseBindMatrices"), f);
     }
     for anim in arr(root, "animations") {
-        for s in anim.get_mut("samplers").and_then(Value::as_array_mut).into_iter().flatten() {
+        for s in anim
+            .get_mut("samplers")
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
             visit_u64(s.get_mut("input"), f);
             visit_u64(s.get_mut("output"), f);
         }
     }
     for node in arr(root, "nodes") {
-        visit_values(node.pointer_mut("/extensions/EXT_mesh_gpu_instancing/attributes"), f);
+        visit_values(
+            node.pointer_mut("/extensions/EXT_mesh_gpu_instancing/attributes"),
+            f,
+        );
     }
 }
 
@@ -282,17 +385,32 @@ fn for_each_view_ref(root: &mut Map<String, Value>, f: &mut dyn FnMut(&mut u64))
         visit_u64(image.get_mut("bufferView"), f);
     }
     for mesh in arr(root, "meshes") {
-        for prim in mesh.get_mut("primitives").and_then(Value::as_array_mut).into_iter().flatten() {
-            visit_u64(prim.pointer_mut("/extensions/KHR_draco_mesh_compression/bufferView"), f);
+        for prim in mesh
+            .get_mut("primitives")
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
+            visit_u64(
+                prim.pointer_mut("/extensions/KHR_draco_mesh_compression/bufferView"),
+                f,
+            );
         }
     }
 }
 
 /// Moves images stored as separate files into the output's buffer, because their relative
 /// `uri`s would not resolve from the output's folder. Network `uri`s are kept as they are.
-fn embed_external_images(doc: &Document, root: &mut Map<String, Value>, bin: &mut Vec<u8>, views: &mut Vec<Value>) -> Result<()> {
+fn embed_external_images(
+    doc: &Document,
+    root: &mut Map<String, Value>,
+    bin: &mut Vec<u8>,
+    views: &mut Vec<Value>,
+) -> Result<()> {
     for (i, image) in arr(root, "images").enumerate() {
-        let Some(u) = image.get("uri").and_then(Value::as_str).map(str::to_owned) else { continue };
+        let Some(u) = image.get("uri").and_then(Value::as_str).map(str::to_owned) else {
+            continue;
+        };
         let at = format!("images[{i}].uri");
         let target = match uri::resolve(&u, &at, doc.base_dir.as_deref(), doc.allow_outside_uris) {
             Ok(uri::Target::File(f)) => f,
@@ -300,13 +418,19 @@ fn embed_external_images(doc: &Document, root: &mut Map<String, Value>, bin: &mu
             Err(_) if u.contains("://") => continue,
             Err(e) => return Err(e),
         };
-        let bytes = std::fs::read(&target).map_err(|e| Error::io(format!("{at} ({})", target.display()), e))?;
+        let bytes = std::fs::read(&target)
+            .map_err(|e| Error::io(format!("{at} ({})", target.display()), e))?;
         let mime = image
             .get("mimeType")
             .and_then(Value::as_str)
             .map(str::to_owned)
             .or_else(|| mime_of(&target, &bytes))
-            .ok_or_else(|| Error::invalid(&at, "cannot tell the image's type to embed it (expected png, jpeg, webp or ktx2)"))?;
+            .ok_or_else(|| {
+                Error::invalid(
+                    &at,
+                    "cannot tell the image's type to embed it (expected png, jpeg, webp or ktx2)",
+                )
+            })?;
         align4(bin);
         views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() }));
         bin.extend_from_slice(&bytes);
@@ -330,7 +454,10 @@ fn mime_of(path: &Path, bytes: &[u8]) -> Option<String> {
     } else {
         None
     };
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
     by_magic
         .or(match ext.as_deref() {
             Some("png") => Some("image/png"),
@@ -350,7 +477,8 @@ fn fix_extension_lists(root: &mut Map<String, Value>) {
         if let Some(list) = root.get_mut(key).and_then(Value::as_array_mut) {
             list.retain(|e| {
                 let name = e.as_str().unwrap_or("");
-                !meshopt_decode::EXTENSIONS.contains(&name) && (quantized || name != "KHR_mesh_quantization")
+                !meshopt_decode::EXTENSIONS.contains(&name)
+                    && (quantized || name != "KHR_mesh_quantization")
             });
             if list.is_empty() {
                 root.remove(key);
@@ -368,23 +496,41 @@ fn fix_extension_lists(root: &mut Map<String, Value>) {
 
 /// Does any primitive attribute still use a format only KHR_mesh_quantization allows?
 fn uses_quantized_attributes(root: &mut Map<String, Value>) -> bool {
-    let accessors = root.get("accessors").and_then(Value::as_array).cloned().unwrap_or_default();
+    let accessors = root
+        .get("accessors")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
     let format = |i: u64| {
         let a = &accessors[i as usize];
-        (a["componentType"].as_u64().unwrap_or(5126), a["normalized"].as_bool().unwrap_or(false))
+        (
+            a["componentType"].as_u64().unwrap_or(5126),
+            a["normalized"].as_bool().unwrap_or(false),
+        )
     };
     let mut found = false;
-    let meshes = root.get("meshes").and_then(Value::as_array).cloned().unwrap_or_default();
-    for prim in meshes.iter().filter_map(|m| m["primitives"].as_array()).flatten() {
+    let meshes = root
+        .get("meshes")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    for prim in meshes
+        .iter()
+        .filter_map(|m| m["primitives"].as_array())
+        .flatten()
+    {
         let targets = prim["targets"].as_array().cloned().unwrap_or_default();
-        let sets = std::iter::once((&prim["attributes"], false)).chain(targets.iter().map(|t| (t, true)));
+        let sets =
+            std::iter::once((&prim["attributes"], false)).chain(targets.iter().map(|t| (t, true)));
         for (set, is_target) in sets {
             for (name, i) in set.as_object().into_iter().flatten() {
                 let Some(i) = i.as_u64() else { continue };
                 let (ct, normalized) = format(i);
                 let core = match name.as_str() {
                     "POSITION" | "NORMAL" | "TANGENT" => ct == 5126,
-                    n if n.starts_with("TEXCOORD_") => ct == 5126 || (normalized && (ct == 5121 || ct == 5123)),
+                    n if n.starts_with("TEXCOORD_") => {
+                        ct == 5126 || (normalized && (ct == 5121 || ct == 5123))
+                    }
                     _ => true,
                 };
                 found |= !core || (is_target && ct != 5126 && !name.starts_with('_'));
@@ -393,4 +539,3 @@ fn uses_quantized_attributes(root: &mut Map<String, Value>) -> bool {
     }
     found
 }
-

@@ -54,12 +54,27 @@ pub fn validate(paths: &[&Path]) -> Option<std::collections::BTreeMap<PathBuf, V
         .args(paths)
         .output()
         .expect("node runs");
-    assert!(out.status.success(), "validator failed: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "validator failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let mut verdicts = std::collections::BTreeMap::new();
     for line in String::from_utf8(out.stdout).unwrap().lines() {
         let v: serde_json::Value = serde_json::from_str(line).unwrap();
-        let codes = v["codes"].as_array().unwrap().iter().map(|c| c.as_str().unwrap().to_string()).collect();
-        verdicts.insert(PathBuf::from(v["file"].as_str().unwrap()), Verdict { errors: v["errors"].as_u64().unwrap(), codes });
+        let codes = v["codes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_str().unwrap().to_string())
+            .collect();
+        verdicts.insert(
+            PathBuf::from(v["file"].as_str().unwrap()),
+            Verdict {
+                errors: v["errors"].as_u64().unwrap(),
+                codes,
+            },
+        );
     }
     Some(verdicts)
 }
