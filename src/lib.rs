@@ -19,6 +19,7 @@
 //! - [`continuity`]: measures position gap, normal jump and curvature jump across edges
 //!   ([`continuity::measure`]).
 //! - [`options`]: the resolved settings that flow down through every stage.
+//! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages.
 //!
 //! **Architecture invariant:** [`mesh`], [`topology`], [`surface`] and [`continuity`] take slices
 //! and return values; they know nothing of glTF, files, clap or meshopt, and never fail on bad
@@ -31,6 +32,7 @@ pub mod continuity;
 pub mod gltf_io;
 pub mod mesh;
 pub mod options;
+pub mod pipeline;
 pub mod sharpness;
 pub mod surface;
 pub mod topology;

@@ -1,1 +1,223 @@
-//! TODO
+//! The one resolved settings struct, [`Options`], with every default as a `DEFAULT_*` constant,
+//! and the overlay of a TOML configuration file onto it.
+//!
+//! `config/default.toml` states the same defaults for users; a test keeps the two equal. This
+//! module deliberately knows nothing of the command line: the binary turns its arguments into an
+//! [`Options`].
+
+use serde::Deserialize;
+
+/// Default tessellation level: every input edge is split into this many segments.
+pub const DEFAULT_LEVEL: u32 = 4;
+/// Largest accepted level (level² triangles per input triangle).
+pub const MAX_LEVEL: u32 = 64;
+/// Default blend width `h`, in the paper's reference triangle (0.6 of the maximum).
+pub const DEFAULT_H: f64 = 0.212;
+/// Largest blend width: sqrt(2)/4, a quarter of the reference triangle's side.
+pub const MAX_H: f64 = std::f64::consts::SQRT_2 / 4.0;
+/// Default crease angle in degrees: edges whose faces meet more sharply get `h = 0`.
+pub const DEFAULT_CREASE_ANGLE: f64 = 60.0;
+/// Default blend profile.
+pub const DEFAULT_PROFILE: Profile = Profile::Paper;
+/// Default surface scheme.
+pub const DEFAULT_SCHEME: Scheme = Scheme::G2;
+/// Default cap on output triangles per input file, so a typo in `level` cannot fill the disk.
+pub const DEFAULT_MAX_OUTPUT_TRIANGLES: u64 = 50_000_000;
+/// Default: `uri`s may not leave the asset's folder.
+pub const DEFAULT_ALLOW_OUTSIDE_URIS: bool = false;
+/// Default: never overwrite an input file.
+pub const DEFAULT_FORCE: bool = false;
+/// Default: write float attributes (no KHR_mesh_quantization).
+pub const DEFAULT_QUANTIZE: bool = false;
+/// Default: write uncompressed buffers (no EXT_meshopt_compression).
+pub const DEFAULT_COMPRESS: bool = false;
+
+/// The radial profile r(s) of the blending region.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Profile {
+    /// The paper's line–arc–plateau profile (C¹ where its pieces meet).
+    Paper,
+    /// A C² profile that removes the paper's G¹ seams inside the blending region.
+    C2,
+}
+
+/// Which smooth surface replaces each triangle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Scheme {
+    /// G²-blended PN triangles.
+    G2,
+    /// Plain PN triangles.
+    Pn,
+    /// G² where the mesh allows, PN elsewhere.
+    Hybrid,
+    /// Coons-patch blending.
+    Coons,
+}
+
+/// Every setting, resolved. Defaults are the `DEFAULT_*` constants of this module.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Options {
+    /// Segments per input edge. Default: [`DEFAULT_LEVEL`]; range 1..=[`MAX_LEVEL`].
+    pub level: u32,
+    /// Blend width for edges with no other source. Default: [`DEFAULT_H`]; range 0..=[`MAX_H`].
+    pub h: f64,
+    /// Crease angle in degrees. Default: [`DEFAULT_CREASE_ANGLE`]; range 0..=180.
+    pub crease_angle: f64,
+    /// Blend profile. Default: [`DEFAULT_PROFILE`].
+    pub profile: Profile,
+    /// Surface scheme. Default: [`DEFAULT_SCHEME`].
+    pub scheme: Scheme,
+    /// Output triangle cap per file. Default: [`DEFAULT_MAX_OUTPUT_TRIANGLES`]; at least 1.
+    pub max_output_triangles: u64,
+    /// Allow `uri`s outside the asset's folder. Default: [`DEFAULT_ALLOW_OUTSIDE_URIS`].
+    pub allow_outside_uris: bool,
+    /// Allow overwriting an input. Default: [`DEFAULT_FORCE`].
+    pub force: bool,
+    /// Quantize output attributes. Default: [`DEFAULT_QUANTIZE`].
+    pub quantize: bool,
+    /// Compress output buffers. Default: [`DEFAULT_COMPRESS`].
+    pub compress: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            level: DEFAULT_LEVEL,
+            h: DEFAULT_H,
+            crease_angle: DEFAULT_CREASE_ANGLE,
+            profile: DEFAULT_PROFILE,
+            scheme: DEFAULT_SCHEME,
+            max_output_triangles: DEFAULT_MAX_OUTPUT_TRIANGLES,
+            allow_outside_uris: DEFAULT_ALLOW_OUTSIDE_URIS,
+            force: DEFAULT_FORCE,
+            quantize: DEFAULT_QUANTIZE,
+            compress: DEFAULT_COMPRESS,
+        }
+    }
+}
+
+/// A configuration file: every key optional; unknown keys are an error (a typo must not be
+/// silently ignored).
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConfigFile {
+    pub level: Option<u32>,
+    pub h: Option<f64>,
+    pub crease_angle: Option<f64>,
+    pub profile: Option<Profile>,
+    pub scheme: Option<Scheme>,
+    pub max_output_triangles: Option<u64>,
+    pub allow_outside_uris: Option<bool>,
+    pub force: Option<bool>,
+    pub quantize: Option<bool>,
+    pub compress: Option<bool>,
+}
+
+/// A configuration problem: `<where>: <what> (expected …)`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{at}: {what}")]
+pub struct ConfigError {
+    /// File and line, or the option's name.
+    pub at: String,
+    /// What is wrong.
+    pub what: String,
+}
+
+impl ConfigFile {
+    /// Parses TOML text; `origin` names it in errors (`file.toml:12: …`).
+    pub fn parse(text: &str, origin: &str) -> Result<Self, ConfigError> {
+        toml::from_str(text).map_err(|e: toml::de::Error| {
+            let line = e.span().map(|s| text[..s.start].matches('\n').count() + 1);
+            ConfigError {
+                at: line.map_or(origin.to_string(), |l| format!("{origin}:{l}")),
+                what: e.message().to_lowercase(),
+            }
+        })
+    }
+}
+
+impl Options {
+    /// These options with every key `config` sets replaced.
+    pub fn overlay(mut self, config: &ConfigFile) -> Self {
+        macro_rules! take {
+            ($($f:ident),*) => { $( if let Some(v) = config.$f { self.$f = v; } )* };
+        }
+        take!(
+            level,
+            h,
+            crease_angle,
+            profile,
+            scheme,
+            max_output_triangles,
+            allow_outside_uris,
+            force,
+            quantize,
+            compress
+        );
+        self
+    }
+
+    /// Checks every range; `origin` names where the values came from.
+    pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
+        let err = |key: &str, what: String| {
+            Err(ConfigError {
+                at: format!("{origin}: {key}"),
+                what,
+            })
+        };
+        if !(1..=MAX_LEVEL).contains(&self.level) {
+            return err(
+                "level",
+                format!("is {} (expected 1 to {MAX_LEVEL})", self.level),
+            );
+        }
+        if !(0.0..=MAX_H).contains(&self.h) {
+            return err("h", format!("is {} (expected 0 to {MAX_H:.4})", self.h));
+        }
+        if !(0.0..=180.0).contains(&self.crease_angle) {
+            return err(
+                "crease_angle",
+                format!("is {} (expected 0 to 180 degrees)", self.crease_angle),
+            );
+        }
+        if self.max_output_triangles == 0 {
+            return err("max_output_triangles", "is 0 (expected at least 1)".into());
+        }
+        Ok(())
+    }
+
+    /// The reader settings these options imply.
+    pub fn read_options(&self) -> crate::gltf_io::ReadOptions {
+        crate::gltf_io::ReadOptions {
+            allow_outside_uris: self.allow_outside_uris,
+            ..Default::default()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_keys_are_errors_with_a_line() {
+        let e = ConfigFile::parse("level = 2\nlevle = 3\n", "x.toml").unwrap_err();
+        assert_eq!(e.at, "x.toml:2");
+    }
+
+    #[test]
+    fn out_of_range_h_is_refused() {
+        let o = Options::default().overlay(&ConfigFile {
+            h: Some(1.7),
+            ..Default::default()
+        });
+        assert!(o
+            .validate("--h")
+            .unwrap_err()
+            .what
+            .contains("expected 0 to 0.3536"));
+    }
+}

@@ -1,1 +1,32 @@
-//! TODO
+//! glTF in and out: reads `.gltf`/`.glb` into a [`Document`] that keeps everything, exposes its
+//! triangle primitives as plain arrays, and writes the document back with replaced primitives.
+//!
+//! The only module that speaks glTF. It deliberately does no geometry: the pipeline reads a
+//! [`PrimitiveData`], computes a new one and hands it to [`replace_primitive`].
+//!
+//! - [`document`]: reading, [`Document`], [`ReadOptions`]
+//! - [`glb`]: the GLB container
+//! - [`uri`]: `data:` and file `uri`s, bounded to the asset's folder
+//! - [`meshopt_decode`]: EXT_/KHR_meshopt_compression buffer views
+//! - [`accessor`]: every accessor layout, sparse and zero-filled ones
+//! - [`validate`]: what the spec calls an error, refused at read time
+//! - [`primitive`]: [`PrimitiveData`] out of and back into a document
+//! - [`json_merge`]: keeps what the typed JSON model loses
+//! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically
+//! - [`error`]: [`Error`], located by JSON path
+
+pub mod accessor;
+pub mod document;
+pub mod error;
+pub mod glb;
+pub mod json_merge;
+pub mod meshopt_decode;
+pub mod primitive;
+pub mod uri;
+pub mod validate;
+pub mod write;
+
+pub use document::{read, read_bytes, Document, ReadOptions};
+pub use error::{Error, ErrorKind, Result};
+pub use primitive::{replace_primitive, Attribute, PrimitiveData, Values};
+pub use write::{write, WriteOptions};

@@ -1,0 +1,268 @@
+//! Decodes accessors: every component type, `normalized`, `byteStride` and interleaving, matrix
+//! column padding, sparse substitution (also without a base buffer view) and zero-filled
+//! accessors.
+//!
+//! Every declared count and offset is checked against the bytes present before anything is
+//! allocated. It deliberately does not interpret semantics (that is [`super::primitive`]'s job).
+
+use gltf_json::accessor::{ComponentType, Type};
+use gltf_json::validation::Checked;
+
+use super::document::Document;
+use super::error::{Error, Result};
+
+/// An accessor's elements, tightly packed (no stride, no matrix padding), little-endian.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Accessor {
+    /// The stored component type.
+    pub component_type: ComponentType,
+    /// Components per element (1 for SCALAR … 16 for MAT4).
+    pub components: usize,
+    /// Whether integer components map to [0, 1] or [-1, 1].
+    pub normalized: bool,
+    /// Number of elements.
+    pub count: usize,
+    bytes: Vec<u8>,
+}
+
+/// Bytes per component.
+pub fn component_size(t: ComponentType) -> usize {
+    match t {
+        ComponentType::I8 | ComponentType::U8 => 1,
+        ComponentType::I16 | ComponentType::U16 => 2,
+        ComponentType::U32 | ComponentType::F32 => 4,
+    }
+}
+
+/// Components per element.
+pub fn type_components(t: Type) -> usize {
+    match t {
+        Type::Scalar => 1,
+        Type::Vec2 => 2,
+        Type::Vec3 => 3,
+        Type::Vec4 | Type::Mat2 => 4,
+        Type::Mat3 => 9,
+        Type::Mat4 => 16,
+    }
+}
+
+/// The accessor type holding `n` components of a vertex attribute.
+pub fn vector_type(n: usize) -> Type {
+    match n {
+        1 => Type::Scalar,
+        2 => Type::Vec2,
+        3 => Type::Vec3,
+        _ => Type::Vec4,
+    }
+}
+
+/// (rows, bytes per column incl. padding, columns) of one element as stored in a buffer.
+fn stored_layout(t: Type, csize: usize) -> (usize, usize, usize) {
+    let (rows, cols) = match t {
+        Type::Mat2 => (2, 2),
+        Type::Mat3 => (3, 3),
+        Type::Mat4 => (4, 4),
+        other => (type_components(other), 1),
+    };
+    let col = rows * csize;
+    let col_padded = if cols > 1 { col.div_ceil(4) * 4 } else { col };
+    (rows, col_padded, cols)
+}
+
+/// Reads accessor `index` of `doc`, applying sparse substitution.
+pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
+    let at = format!("accessors[{index}]");
+    let a = doc
+        .root
+        .accessors
+        .get(index)
+        .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
+    let (Checked::Valid(ct), Checked::Valid(ty)) = (&a.component_type, &a.type_) else {
+        return Err(Error::invalid(&at, "has an invalid componentType or type"));
+    };
+    let ct = ct.0;
+    let csize = component_size(ct);
+    let components = type_components(*ty);
+    let (rows, col_bytes, cols) = stored_layout(*ty, csize);
+    let elem_stored = col_bytes * cols;
+    let elem_packed = components * csize;
+    let count = a.count.0;
+    let total = count
+        .checked_mul(elem_packed as u64)
+        .filter(|t| *t <= max_bytes)
+        .ok_or_else(|| {
+            Error::invalid(
+                format!("{at}.count"),
+                format!("{count} elements exceed the limit of {max_bytes} bytes"),
+            )
+        })?;
+    let count = count as usize;
+    let mut bytes = Vec::new();
+    match a.buffer_view {
+        Some(view) => {
+            let v = &doc.root.buffer_views[view.value()];
+            let data = doc.view_bytes(view.value())?;
+            let stride = v.byte_stride.map_or(elem_stored, |s| s.0);
+            let offset = a.byte_offset.map_or(0, |o| o.0) as usize;
+            if count > 0 {
+                let need = (count as u64 - 1) * stride as u64 + offset as u64 + elem_stored as u64;
+                if need > data.len() as u64 {
+                    return Err(Error::invalid(
+                        &at,
+                        format!(
+                            "{count} elements of {elem_stored} bytes at offset {offset} with stride {stride} need {need} bytes, but bufferViews[{}] has {} (expected the data to fit)",
+                            view.value(),
+                            data.len()
+                        ),
+                    ));
+                }
+            }
+            bytes.reserve_exact(total as usize);
+            for i in 0..count {
+                let e = offset + i * stride;
+                for c in 0..cols {
+                    let s = e + c * col_bytes;
+                    bytes.extend_from_slice(&data[s..s + rows * csize]);
+                }
+            }
+        }
+        None => bytes.resize(total as usize, 0),
+    }
+    if let Some(sparse) = &a.sparse {
+        let sat = format!("{at}.sparse");
+        let n = sparse.count.0 as usize;
+        if n as u64 > count as u64 {
+            return Err(Error::invalid(
+                format!("{sat}.count"),
+                format!("{n} exceeds the accessor's count {count}"),
+            ));
+        }
+        let Checked::Valid(ict) = &sparse.indices.component_type else {
+            return Err(Error::invalid(
+                format!("{sat}.indices.componentType"),
+                "invalid (expected 5121, 5123 or 5125)",
+            ));
+        };
+        let isize = component_size(ict.0);
+        let idata = sparse_slice(
+            doc,
+            sparse.indices.buffer_view.value(),
+            sparse.indices.byte_offset.0,
+            n * isize,
+            &format!("{sat}.indices"),
+        )?;
+        let vdata = sparse_slice(
+            doc,
+            sparse.values.buffer_view.value(),
+            sparse.values.byte_offset.0,
+            n * elem_stored,
+            &format!("{sat}.values"),
+        )?;
+        let mut previous = None;
+        for k in 0..n {
+            let target = read_uint(&idata[k * isize..], ict.0) as usize;
+            if target >= count || previous.is_some_and(|p| target <= p) {
+                return Err(Error::invalid(
+                    format!("{sat}.indices"),
+                    format!("index {target} at position {k} is out of range or not increasing (expected strictly increasing values below {count})"),
+                ));
+            }
+            previous = Some(target);
+            let mut w = target * elem_packed;
+            for c in 0..cols {
+                let s = k * elem_stored + c * col_bytes;
+                bytes[w..w + rows * csize].copy_from_slice(&vdata[s..s + rows * csize]);
+                w += rows * csize;
+            }
+        }
+    }
+    Ok(Accessor {
+        component_type: ct,
+        components,
+        normalized: a.normalized,
+        count,
+        bytes,
+    })
+}
+
+fn sparse_slice<'a>(
+    doc: &'a Document,
+    view: usize,
+    offset: u64,
+    len: usize,
+    at: &str,
+) -> Result<&'a [u8]> {
+    let data = doc.view_bytes(view)?;
+    let start = offset as usize;
+    data.get(start..start.saturating_add(len)).ok_or_else(|| {
+        Error::invalid(
+            at,
+            format!(
+                "{len} bytes at offset {offset} do not fit in bufferViews[{view}] of {} bytes",
+                data.len()
+            ),
+        )
+    })
+}
+
+fn read_uint(b: &[u8], t: ComponentType) -> u32 {
+    match t {
+        ComponentType::U8 | ComponentType::I8 => b[0] as u32,
+        ComponentType::U16 | ComponentType::I16 => u16::from_le_bytes([b[0], b[1]]) as u32,
+        _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+    }
+}
+
+impl Accessor {
+    /// Component `i` (flat index) as stored, widened without scaling.
+    pub fn raw(&self, i: usize) -> f64 {
+        let s = component_size(self.component_type);
+        let b = &self.bytes[i * s..];
+        match self.component_type {
+            ComponentType::I8 => b[0] as i8 as f64,
+            ComponentType::U8 => b[0] as f64,
+            ComponentType::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+            ComponentType::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+            ComponentType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            ComponentType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        }
+    }
+
+    /// Number of components in total (`count × components`).
+    pub fn len(&self) -> usize {
+        self.count * self.components
+    }
+
+    /// Whether the accessor holds no elements.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Every component as `f32`, normalized integers mapped as the spec says
+    /// (e.g. `max(c / 127, -1)` for signed bytes); floats are bit-exact.
+    pub fn to_f32(&self) -> Vec<f32> {
+        if self.component_type == ComponentType::F32 {
+            return self
+                .bytes
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+        }
+        let scale = match (self.normalized, self.component_type) {
+            (false, _) => 1.0,
+            (true, ComponentType::I8) => 127.0,
+            (true, ComponentType::U8) => 255.0,
+            (true, ComponentType::I16) => 32767.0,
+            (true, ComponentType::U16) => 65535.0,
+            (true, _) => 4294967295.0,
+        };
+        (0..self.len())
+            .map(|i| ((self.raw(i) / scale).max(-1.0)) as f32)
+            .collect()
+    }
+
+    /// Every component as `u32` (for indices, joints and integer IDs).
+    pub fn to_u32(&self) -> Vec<u32> {
+        (0..self.len()).map(|i| self.raw(i) as u32).collect()
+    }
+}

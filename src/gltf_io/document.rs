@@ -1,0 +1,382 @@
+//! Reading a `.gltf`/`.glb` into a [`Document`]: the JSON twice (as written, and as the typed
+//! `gltf-json` model), every buffer's bytes, and meshopt-compressed views decoded.
+//!
+//! It deliberately does not refuse unknown required extensions (they are carried through
+//! verbatim); it refuses only what it cannot read correctly, and everything the spec calls an
+//! error (see [`super::validate`]).
+
+use std::path::{Path, PathBuf};
+
+use gltf_json::validation::{USize64, Validate};
+use serde_json::Value;
+
+use super::error::{Error, Result};
+use super::{glb, meshopt_decode, uri, validate};
+
+/// Bounds and permissions for reading untrusted assets.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct ReadOptions {
+    /// Allow `uri`s that leave the asset's folder (`..`, absolute paths, `file:`).
+    /// Default: `false`. Network schemes are refused regardless.
+    pub allow_outside_uris: bool,
+    /// Largest file, buffer, or decoded accessor the reader accepts, in bytes.
+    /// Default: [`ReadOptions::DEFAULT_MAX_BYTES`] (2 GiB).
+    pub max_bytes: u64,
+}
+
+impl ReadOptions {
+    /// Default for [`ReadOptions::max_bytes`]: large enough for any game asset, small enough
+    /// that a lying header cannot make the reader allocate the machine's memory.
+    pub const DEFAULT_MAX_BYTES: u64 = 2 << 30;
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        Self {
+            allow_outside_uris: false,
+            max_bytes: Self::DEFAULT_MAX_BYTES,
+        }
+    }
+}
+
+/// A glTF asset in memory: everything needed to read its meshes and to write it back unchanged.
+#[derive(Debug, Clone)]
+pub struct Document {
+    /// The typed JSON model. Accessors, buffer views and buffers here are authoritative;
+    /// primitives are changed only through [`super::replace_primitive`].
+    pub root: gltf_json::Root,
+    /// The JSON exactly as read, for everything the typed model does not keep.
+    pub(crate) raw: Value,
+    /// `root` serialized right after reading: what "unchanged" looks like in typed form.
+    pub(crate) base: Value,
+    /// The bytes of each entry of `root.buffers` (a meshopt fallback buffer holds none).
+    pub(crate) buffers: Vec<Vec<u8>>,
+    /// Primitives replaced since reading, as JSON (key: mesh, primitive).
+    pub(crate) replaced: std::collections::BTreeMap<(usize, usize), Value>,
+    /// The accessors the replaced primitives referenced when read.
+    pub(crate) replaced_accessors: std::collections::BTreeSet<usize>,
+    /// The folder relative `uri`s resolve against.
+    pub base_dir: Option<PathBuf>,
+    /// Whether the input was a `.glb`.
+    pub is_glb: bool,
+    /// Whether the reader may follow `uri`s out of `base_dir` (kept for embedding images).
+    pub(crate) allow_outside_uris: bool,
+}
+
+/// Reads the asset at `path` (`.gltf` or `.glb`, told apart by content).
+pub fn read(path: &Path, opts: &ReadOptions) -> Result<Document> {
+    let shown = path.display().to_string();
+    let len = std::fs::metadata(path)
+        .map_err(|e| Error::io(&shown, e))?
+        .len();
+    if len > opts.max_bytes {
+        return Err(Error::invalid(
+            shown,
+            format!("file is {len} bytes (expected at most {})", opts.max_bytes),
+        ));
+    }
+    let bytes = std::fs::read(path).map_err(|e| Error::io(&shown, e))?;
+    let named_glb = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if named_glb && !bytes.starts_with(b"{") {
+        glb::split(&bytes)?; // a .glb that is not JSON either: report its header
+    }
+    let dir = path.parent().map(|p| {
+        if p.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            p
+        }
+    });
+    read_bytes(&bytes, dir, opts)
+}
+
+/// Reads an asset from memory; relative `uri`s resolve against `base_dir` (none: only `data:`).
+pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> Result<Document> {
+    let is_glb = glb::is_glb(bytes);
+    let (json, bin) = if is_glb {
+        let chunks = glb::split(bytes)?;
+        (chunks.json, chunks.bin)
+    } else {
+        (bytes, None)
+    };
+    if json.starts_with(&[0xEF, 0xBB, 0xBF]) {
+        return Err(Error::invalid(
+            "json",
+            "starts with a utf-8 byte order mark, which glTF forbids (expected '{')",
+        ));
+    }
+    let raw: Value = serde_json::from_slice(json)
+        .map_err(|e| Error::invalid("json", e.to_string().to_lowercase()))?;
+    check_version(&raw)?;
+    let root: gltf_json::Root = serde_json::from_value(typed_shim(&raw))
+        .map_err(|e| Error::invalid("json", e.to_string().to_lowercase()))?;
+    validate::primitive_references(&root)?;
+    check_typed(&root)?;
+    validate::structure(&root, &raw)?;
+
+    let buffers = load_buffers(&root, bin, base_dir, opts)?;
+    validate::buffer_views(&root, &buffers)?;
+    let mut doc = Document {
+        base: Value::Null,
+        root,
+        raw,
+        buffers,
+        replaced: Default::default(),
+        replaced_accessors: Default::default(),
+        base_dir: base_dir.map(Path::to_path_buf),
+        is_glb,
+        allow_outside_uris: opts.allow_outside_uris,
+    };
+    meshopt_decode::decode_views(&mut doc, opts.max_bytes)?;
+    validate::data(&doc, opts.max_bytes)?;
+    doc.base = serde_json::to_value(&doc.root).map_err(|e| Error::invalid("json", e))?;
+    Ok(doc)
+}
+
+/// A copy of `raw` with the properties `gltf-json` requires but the spec leaves optional filled
+/// in (`scenes[].nodes`), so that valid files parse. The merge on write drops them again.
+fn typed_shim(raw: &Value) -> Value {
+    let mut v = raw.clone();
+    for scene in v
+        .get_mut("scenes")
+        .and_then(Value::as_array_mut)
+        .into_iter()
+        .flatten()
+    {
+        if let Some(obj) = scene.as_object_mut() {
+            obj.entry("nodes").or_insert_with(|| Value::Array(vec![]));
+        }
+    }
+    v
+}
+
+/// Refuses anything but glTF 2.x, with a message that names glTF 1.0 when it is that.
+fn check_version(raw: &Value) -> Result<()> {
+    let Some(obj) = raw.as_object() else {
+        return Err(Error::invalid(
+            "json",
+            "the top level is not an object (expected a glTF object)",
+        ));
+    };
+    let version = obj
+        .get("asset")
+        .ok_or_else(|| {
+            Error::invalid(
+                "asset",
+                "missing (expected an asset object with version \"2.0\")",
+            )
+        })?
+        .get("version")
+        .and_then(Value::as_str)
+        .ok_or_else(|| Error::invalid("asset.version", "missing (expected \"2.0\")"))?;
+    match version.split('.').next() {
+        Some("2") => Ok(()),
+        Some("1") => Err(Error::unsupported(
+            "asset.version",
+            format!("glTF {version} is not supported (expected 2.0)"),
+        )),
+        _ => Err(Error::invalid(
+            "asset.version",
+            format!("{version:?} is not a glTF version (expected \"2.0\")"),
+        )),
+    }
+}
+
+/// Runs `gltf-json`'s own checks (unresolved references, bad enum values, missing fields), except
+/// its refusal of required extensions it does not know: those are carried through.
+fn check_typed(root: &gltf_json::Root) -> Result<()> {
+    let mut first = None;
+    root.validate(
+        root,
+        gltf_json::Path::new,
+        &mut |path: &dyn Fn() -> gltf_json::Path, err| {
+            use gltf_json::validation::Error as E;
+            if first.is_some() || err == E::Unsupported {
+                return;
+            }
+            // The spec lets accessors omit bufferView (they read as zeros); gltf-json does not.
+            let p = path();
+            // Likewise texture.source, which extensions such as KHR_texture_basisu replace.
+            let optional = [("accessors[", "].bufferView"), ("textures[", "].source")];
+            if err == E::Missing
+                && optional
+                    .iter()
+                    .any(|(a, b)| p.as_str().starts_with(a) && p.as_str().ends_with(b))
+            {
+                return;
+            }
+            let what = match err {
+                E::IndexOutOfBounds => {
+                    "refers to an object that does not exist (expected an index in range)"
+                }
+                E::Invalid => "has a value the glTF specification does not allow",
+                E::Missing => "is missing (expected it by the glTF specification)",
+                E::Oversize => "is larger than this system can address",
+                E::Unsupported => unreachable!(),
+            };
+            first = Some(Error::invalid(path().as_str(), what));
+        },
+    );
+    match first {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Loads every buffer: the GLB BIN chunk, `data:` URIs and files, checking declared lengths.
+fn load_buffers(
+    root: &gltf_json::Root,
+    bin: Option<&[u8]>,
+    base_dir: Option<&Path>,
+    opts: &ReadOptions,
+) -> Result<Vec<Vec<u8>>> {
+    let mut out = Vec::with_capacity(root.buffers.len());
+    for (i, buffer) in root.buffers.iter().enumerate() {
+        let at = format!("buffers[{i}]");
+        let declared = buffer.byte_length.0;
+        if declared > opts.max_bytes {
+            return Err(Error::invalid(
+                &at,
+                format!(
+                    "byteLength {declared} exceeds the limit of {} bytes",
+                    opts.max_bytes
+                ),
+            ));
+        }
+        let data = match (&buffer.uri, bin) {
+            (Some(u), _) => {
+                let data = uri::load(
+                    u,
+                    &format!("{at}.uri"),
+                    base_dir,
+                    opts.allow_outside_uris,
+                    opts.max_bytes,
+                )?;
+                if u.starts_with("data:") && data.len() as u64 != declared {
+                    return Err(Error::invalid(
+                        format!("{at}.byteLength"),
+                        format!(
+                            "is {declared} but the data: uri holds {} bytes (expected equal)",
+                            data.len()
+                        ),
+                    ));
+                }
+                data
+            }
+            (None, Some(bin)) if i == 0 => bin.to_vec(),
+            (None, _)
+                if meshopt_decode::is_fallback(buffer)
+                    || meshopt_decode::only_compressed_views(root, i) =>
+            {
+                Vec::new()
+            }
+            (None, _) => {
+                return Err(Error::invalid(
+                    format!("{at}.uri"),
+                    "missing, and the buffer is not the glb's BIN chunk (expected a uri)",
+                ))
+            }
+        };
+        let placeholder = buffer.uri.is_none() && (i != 0 || bin.is_none());
+        if !placeholder && (data.len() as u64) < declared {
+            return Err(Error::invalid(
+                format!("{at}.byteLength"),
+                format!("is {declared} but only {} bytes are present (expected at most the data's length)", data.len()),
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+impl Document {
+    /// The bytes of buffer view `view`, bounds already checked at read time.
+    pub(crate) fn view_bytes(&self, view: usize) -> Result<&[u8]> {
+        let v = self
+            .root
+            .buffer_views
+            .get(view)
+            .ok_or_else(|| Error::invalid(format!("bufferViews[{view}]"), "does not exist"))?;
+        let data = &self.buffers[v.buffer.value()];
+        let start = v.byte_offset.map_or(0, |o| o.0) as usize;
+        let end = start + v.byte_length.0 as usize;
+        data.get(start..end).ok_or_else(|| {
+            Error::invalid(
+                format!("bufferViews[{view}]"),
+                format!(
+                    "bytes {start}..{end} are not in its buffer of {} bytes",
+                    data.len()
+                ),
+            )
+        })
+    }
+
+    /// Appends `bytes` as a new buffer view in the document's scratch buffer; returns its index.
+    pub(crate) fn push_view(
+        &mut self,
+        bytes: &[u8],
+        stride: Option<usize>,
+        target: Option<gltf_json::buffer::Target>,
+    ) -> usize {
+        let scratch = self.scratch_buffer();
+        let data = &mut self.buffers[scratch];
+        while data.len() % 4 != 0 {
+            data.push(0);
+        }
+        let offset = data.len();
+        data.extend_from_slice(bytes);
+        self.root.buffers[scratch].byte_length = USize64(data.len() as u64);
+        self.root.buffer_views.push(gltf_json::buffer::View {
+            buffer: gltf_json::Index::new(scratch as u32),
+            byte_length: USize64(bytes.len() as u64),
+            byte_offset: Some(USize64(offset as u64)),
+            byte_stride: stride.map(gltf_json::buffer::Stride),
+            name: None,
+            target: target.map(gltf_json::validation::Checked::Valid),
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.root.buffer_views.len() - 1
+    }
+
+    /// The in-memory buffer that new views go into, created on first use.
+    fn scratch_buffer(&mut self) -> usize {
+        const NAME: &str = "g2tess scratch";
+        if let Some(i) = self
+            .root
+            .buffers
+            .iter()
+            .position(|b| b.name.as_deref() == Some(NAME) && b.uri.is_none())
+        {
+            return i;
+        }
+        self.root.buffers.push(gltf_json::Buffer {
+            byte_length: USize64(0),
+            name: Some(NAME.into()),
+            uri: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.buffers.push(Vec::new());
+        self.buffers.len() - 1
+    }
+
+    /// Points buffer view `view` at `bytes` (decoded meshopt data) in the scratch buffer.
+    pub(crate) fn relocate_view(&mut self, view: usize, bytes: &[u8]) {
+        let scratch = self.scratch_buffer();
+        let data = &mut self.buffers[scratch];
+        while data.len() % 4 != 0 {
+            data.push(0);
+        }
+        let offset = data.len();
+        data.extend_from_slice(bytes);
+        self.root.buffers[scratch].byte_length = USize64(data.len() as u64);
+        let v = &mut self.root.buffer_views[view];
+        v.buffer = gltf_json::Index::new(scratch as u32);
+        v.byte_offset = Some(USize64(offset as u64));
+        v.byte_length = USize64(bytes.len() as u64);
+    }
+}

@@ -1,0 +1,449 @@
+//! A mesh primitive as plain arrays ([`PrimitiveData`]): reading one out of a [`Document`]
+//! (strips and fans turned into triangle lists, non-indexed primitives given indices) and putting
+//! one back as new accessors.
+//!
+//! It deliberately keeps everything about the primitive it does not understand (material,
+//! extensions, extras) and refuses Draco-compressed primitives rather than reading their
+//! placeholder accessors, which hold zeros.
+
+use gltf_json::accessor::{ComponentType, GenericComponentType, Type};
+use gltf_json::mesh::Mode;
+use gltf_json::validation::{Checked, USize64};
+use serde_json::{json, Map, Value};
+
+use super::accessor::{self, component_size, vector_type};
+use super::document::{Document, ReadOptions};
+use super::error::{Error, Result};
+use super::validate::is_triangle_mode;
+
+/// The values of one vertex attribute.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Values {
+    /// Float-valued data (positions, normals, UVs, colors, weights; quantized data dequantized).
+    Float(Vec<f32>),
+    /// Integer data that must not be interpolated (joint indices, unsigned `_` IDs).
+    Uint(Vec<u32>),
+}
+
+impl Values {
+    /// Number of components stored.
+    pub fn len(&self) -> usize {
+        match self {
+            Values::Float(v) => v.len(),
+            Values::Uint(v) => v.len(),
+        }
+    }
+
+    /// Whether no components are stored.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// One named vertex attribute, decoded, with the format it was stored in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attribute {
+    /// The glTF semantic, e.g. `POSITION`, `TEXCOORD_0`, `_FEATURE_ID_0`.
+    pub name: String,
+    /// Components per vertex (1 to 4).
+    pub components: usize,
+    /// The values, `components` per vertex.
+    pub values: Values,
+    /// The component type it was stored with (integer attributes are written back in it).
+    pub component_type: ComponentType,
+    /// Whether it was stored normalized.
+    pub normalized: bool,
+}
+
+impl Attribute {
+    /// Number of vertices.
+    pub fn count(&self) -> usize {
+        self.values.len() / self.components.max(1)
+    }
+}
+
+/// A triangle primitive as arrays: attributes, a triangle list, morph targets.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PrimitiveData {
+    /// Vertex attributes in the order the file lists them.
+    pub attributes: Vec<Attribute>,
+    /// Three vertex indices per triangle, in the primitive's winding.
+    pub indices: Vec<u32>,
+    /// Morph targets: per target, its displacement attributes.
+    pub targets: Vec<Vec<Attribute>>,
+}
+
+impl PrimitiveData {
+    /// The attribute named `name`, if present.
+    pub fn attribute(&self, name: &str) -> Option<&Attribute> {
+        self.attributes.iter().find(|a| a.name == name)
+    }
+
+    /// Number of vertices (of POSITION).
+    pub fn vertex_count(&self) -> usize {
+        self.attribute("POSITION").map_or(0, Attribute::count)
+    }
+}
+
+fn index_of(v: &Value, at: &str) -> Result<usize> {
+    v.as_u64()
+        .map(|i| i as usize)
+        .ok_or_else(|| Error::invalid(at, "is not an index"))
+}
+
+impl Document {
+    /// The JSON of a primitive as it will be written (replaced or as read).
+    pub(crate) fn primitive_json(&self, mesh: usize, prim: usize) -> Option<&Value> {
+        self.replaced.get(&(mesh, prim)).or_else(|| {
+            self.raw
+                .get("meshes")?
+                .get(mesh)?
+                .get("primitives")?
+                .get(prim)
+        })
+    }
+
+    /// Every (mesh, primitive) whose mode is a triangle list, strip or fan, in file order.
+    pub fn triangle_primitives(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for (m, mesh) in self.root.meshes.iter().enumerate() {
+            for (p, prim) in mesh.primitives.iter().enumerate() {
+                if is_triangle_mode(&prim.mode) {
+                    out.push((m, p));
+                }
+            }
+        }
+        out
+    }
+
+    /// Decodes primitive `prim` of mesh `mesh`: every attribute, a triangle list, morph targets.
+    pub fn read_primitive(&self, mesh: usize, prim: usize) -> Result<PrimitiveData> {
+        let at = format!("meshes[{mesh}].primitives[{prim}]");
+        let json = self
+            .primitive_json(mesh, prim)
+            .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
+        if let Some(ext) = json.get("extensions").and_then(Value::as_object) {
+            if let Some(name) = ext
+                .keys()
+                .find(|k| k.as_str() == "KHR_draco_mesh_compression")
+            {
+                return Err(Error::unsupported(
+                    format!("{at}.extensions.{name}"),
+                    "draco-compressed geometry cannot be decoded by this tool (expected uncompressed or meshopt-compressed data)",
+                ));
+            }
+        }
+        let max =
+            ReadOptions::DEFAULT_MAX_BYTES.max(self.buffers.iter().map(|b| b.len() as u64).sum());
+        let attributes = read_attributes(
+            self,
+            json.get("attributes"),
+            &format!("{at}.attributes"),
+            false,
+            max,
+        )?;
+        let vertices = attributes.first().map_or(0, Attribute::count);
+        let list: Vec<u32> = match json.get("indices") {
+            Some(i) => accessor::read(self, index_of(i, &format!("{at}.indices"))?, max)?.to_u32(),
+            None => (0..vertices as u32).collect(),
+        };
+        let mode = json.get("mode").and_then(Value::as_u64).unwrap_or(4);
+        let indices = match mode {
+            4 => list[..list.len() - list.len() % 3].to_vec(),
+            5 => (0..list.len().saturating_sub(2))
+                .flat_map(|i| {
+                    let odd = i % 2;
+                    [list[i], list[i + 1 + odd], list[i + 2 - odd]]
+                })
+                .collect(),
+            6 => (1..list.len().saturating_sub(1))
+                .flat_map(|i| [list[i], list[i + 1], list[0]])
+                .collect(),
+            other => {
+                return Err(Error::invalid(
+                    format!("{at}.mode"),
+                    format!("{other} is not a triangle mode (expected 4, 5 or 6)"),
+                ))
+            }
+        };
+        let mut targets = Vec::new();
+        for (t, target) in json
+            .get("targets")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .enumerate()
+        {
+            targets.push(read_attributes(
+                self,
+                Some(target),
+                &format!("{at}.targets[{t}]"),
+                true,
+                max,
+            )?);
+        }
+        Ok(PrimitiveData {
+            attributes,
+            indices,
+            targets,
+        })
+    }
+}
+
+/// Decodes an `attributes` (or morph target) object.
+fn read_attributes(
+    doc: &Document,
+    obj: Option<&Value>,
+    at: &str,
+    target: bool,
+    max: u64,
+) -> Result<Vec<Attribute>> {
+    let Some(obj) = obj.and_then(Value::as_object) else {
+        return Err(Error::invalid(at, "is not an object of accessor indices"));
+    };
+    let mut out = Vec::with_capacity(obj.len());
+    for (name, index) in obj {
+        let acc = accessor::read(doc, index_of(index, &format!("{at}.{name}"))?, max)?;
+        let unsigned_int = !acc.normalized
+            && matches!(
+                acc.component_type,
+                ComponentType::U8 | ComponentType::U16 | ComponentType::U32
+            );
+        let integer =
+            !target && unsigned_int && (name.starts_with("JOINTS_") || name.starts_with('_'));
+        let values = if integer {
+            Values::Uint(acc.to_u32())
+        } else {
+            Values::Float(acc.to_f32())
+        };
+        out.push(Attribute {
+            name: name.clone(),
+            components: acc.components,
+            values,
+            component_type: acc.component_type,
+            normalized: acc.normalized,
+        });
+    }
+    Ok(out)
+}
+
+/// Replaces primitive `prim` of mesh `mesh` by `data`: new accessors (with min/max), mode
+/// TRIANGLES; material, extensions, extras and any other property of the primitive are kept.
+pub fn replace_primitive(
+    doc: &mut Document,
+    mesh: usize,
+    prim: usize,
+    data: &PrimitiveData,
+) -> Result<()> {
+    let at = format!("meshes[{mesh}].primitives[{prim}]");
+    let mut json = doc
+        .primitive_json(mesh, prim)
+        .cloned()
+        .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
+    collect_accessor_refs(&json, &mut doc.replaced_accessors);
+    let vertices = data.vertex_count();
+    if let Some(bad) = data.indices.iter().find(|i| **i as usize >= vertices) {
+        return Err(Error::invalid(
+            &at,
+            format!("new index {bad} is not below the vertex count {vertices}"),
+        ));
+    }
+    let mut attributes = Map::new();
+    for a in &data.attributes {
+        if a.count() != vertices {
+            return Err(Error::invalid(
+                format!("{at}.attributes.{}", a.name),
+                format!("has {} vertices (expected {vertices})", a.count()),
+            ));
+        }
+        attributes.insert(a.name.clone(), json!(push_attribute(doc, a)));
+    }
+    let mut targets = Vec::new();
+    for t in &data.targets {
+        let mut obj = Map::new();
+        for a in t {
+            obj.insert(a.name.clone(), json!(push_attribute(doc, a)));
+        }
+        targets.push(Value::Object(obj));
+    }
+    let indices = push_indices(doc, &data.indices, vertices);
+    let obj = json
+        .as_object_mut()
+        .ok_or_else(|| Error::invalid(&at, "is not an object"))?;
+    obj.insert("attributes".into(), Value::Object(attributes));
+    obj.insert("indices".into(), json!(indices));
+    if obj.contains_key("mode") {
+        obj.insert("mode".into(), json!(4));
+    }
+    if targets.is_empty() {
+        obj.remove("targets");
+    } else {
+        obj.insert("targets".into(), Value::Array(targets));
+    }
+    // Keep the typed model in step, for readers of `doc.root`.
+    let typed: gltf_json::mesh::Primitive =
+        serde_json::from_value(json.clone()).map_err(|e| Error::invalid(&at, e.to_string()))?;
+    let slot = &mut doc.root.meshes[mesh].primitives[prim];
+    *slot = typed;
+    slot.mode = Checked::Valid(Mode::Triangles);
+    doc.replaced.insert((mesh, prim), json);
+    Ok(())
+}
+
+/// Adds every accessor index `prim` refers to (attributes, indices, targets) to `out`.
+pub(crate) fn collect_accessor_refs(prim: &Value, out: &mut std::collections::BTreeSet<usize>) {
+    let attrs = prim
+        .get("attributes")
+        .and_then(Value::as_object)
+        .into_iter()
+        .flat_map(|o| o.values());
+    let targets = prim
+        .get("targets")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_object)
+        .flat_map(|o| o.values());
+    for v in attrs.chain(targets).chain(prim.get("indices")) {
+        if let Some(i) = v.as_u64() {
+            out.insert(i as usize);
+        }
+    }
+}
+
+/// Writes one attribute as a new accessor; floats as FLOAT, integers in their original type.
+fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
+    let n = a.components.max(1);
+    let (ct, mut bytes, min, max): (ComponentType, Vec<u8>, Vec<Value>, Vec<Value>) =
+        match &a.values {
+            Values::Float(v) => {
+                let (mut lo, mut hi) = (vec![f32::INFINITY; n], vec![f32::NEG_INFINITY; n]);
+                for (k, x) in v.iter().enumerate() {
+                    lo[k % n] = lo[k % n].min(*x);
+                    hi[k % n] = hi[k % n].max(*x);
+                }
+                let bytes = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+                (
+                    ComponentType::F32,
+                    bytes,
+                    lo.iter().map(|x| json!(*x)).collect(),
+                    hi.iter().map(|x| json!(*x)).collect(),
+                )
+            }
+            Values::Uint(v) => {
+                let ct = match a.component_type {
+                    ComponentType::U8 => ComponentType::U8,
+                    ComponentType::U16 => ComponentType::U16,
+                    _ => ComponentType::U32,
+                };
+                let (mut lo, mut hi) = (vec![u32::MAX; n], vec![0u32; n]);
+                for (k, x) in v.iter().enumerate() {
+                    lo[k % n] = lo[k % n].min(*x);
+                    hi[k % n] = hi[k % n].max(*x);
+                }
+                let bytes = v
+                    .iter()
+                    .flat_map(|x| match ct {
+                        ComponentType::U8 => vec![*x as u8],
+                        ComponentType::U16 => (*x as u16).to_le_bytes().to_vec(),
+                        _ => x.to_le_bytes().to_vec(),
+                    })
+                    .collect();
+                (
+                    ct,
+                    bytes,
+                    lo.iter().map(|x| json!(*x)).collect(),
+                    hi.iter().map(|x| json!(*x)).collect(),
+                )
+            }
+        };
+    // Vertex attribute elements must start on 4-byte boundaries: pad them when they are shorter.
+    let elem = n * component_size(ct);
+    let stride = elem.div_ceil(4) * 4;
+    if stride != elem {
+        bytes = bytes
+            .chunks(elem)
+            .flat_map(|e| {
+                e.iter()
+                    .copied()
+                    .chain(std::iter::repeat_n(0, stride - elem))
+            })
+            .collect();
+    }
+    let count = a.count();
+    let view = doc.push_view(
+        &bytes,
+        (stride != elem).then_some(stride),
+        Some(gltf_json::buffer::Target::ArrayBuffer),
+    );
+    let bounds = count > 0;
+    push_accessor(
+        doc,
+        view,
+        count,
+        ct,
+        vector_type(n),
+        bounds.then(|| Value::Array(min)),
+        bounds.then(|| Value::Array(max)),
+    )
+}
+
+/// Writes a triangle list as u16 indices when they fit (65535 is the restart value), else u32.
+fn push_indices(doc: &mut Document, indices: &[u32], vertices: usize) -> usize {
+    let (ct, bytes): (ComponentType, Vec<u8>) = if vertices <= 65535 {
+        (
+            ComponentType::U16,
+            indices
+                .iter()
+                .flat_map(|i| (*i as u16).to_le_bytes())
+                .collect(),
+        )
+    } else {
+        (
+            ComponentType::U32,
+            indices.iter().flat_map(|i| i.to_le_bytes()).collect(),
+        )
+    };
+    let view = doc.push_view(
+        &bytes,
+        None,
+        Some(gltf_json::buffer::Target::ElementArrayBuffer),
+    );
+    let (lo, hi) = (indices.iter().min(), indices.iter().max());
+    let bounds = lo.zip(hi).map(|(l, h)| (json!([l]), json!([h])));
+    push_accessor(
+        doc,
+        view,
+        indices.len(),
+        ct,
+        Type::Scalar,
+        bounds.as_ref().map(|b| b.0.clone()),
+        bounds.map(|b| b.1),
+    )
+}
+
+fn push_accessor(
+    doc: &mut Document,
+    view: usize,
+    count: usize,
+    ct: ComponentType,
+    ty: Type,
+    min: Option<Value>,
+    max: Option<Value>,
+) -> usize {
+    doc.root.accessors.push(gltf_json::Accessor {
+        buffer_view: Some(gltf_json::Index::new(view as u32)),
+        byte_offset: None,
+        count: USize64(count as u64),
+        component_type: Checked::Valid(GenericComponentType(ct)),
+        extensions: None,
+        extras: Default::default(),
+        type_: Checked::Valid(ty),
+        min,
+        max,
+        name: None,
+        normalized: false,
+        sparse: None,
+    });
+    doc.root.accessors.len() - 1
+}

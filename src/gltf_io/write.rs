@@ -1,0 +1,563 @@
+//! Writing a [`Document`]: `.glb`, or `.gltf` with a `.bin` beside it, chosen by the output's
+//! extension; buffers repacked into one 4-byte-aligned buffer; accessors and views orphaned by
+//! replaced primitives dropped; everything else carried verbatim.
+//!
+//! Files are written to a temporary file beside the target and renamed into place, so an
+//! interrupted run never leaves a half-written output. It deliberately never overwrites the
+//! input (or a file the input refers to) unless asked to.
+
+use std::collections::BTreeSet;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::{json, Map, Value};
+
+use super::document::Document;
+use super::error::{Error, Result};
+use super::{glb, json_merge, meshopt_decode, uri};
+
+/// How to write.
+#[derive(Debug, Clone, Default)]
+#[non_exhaustive]
+pub struct WriteOptions {
+    /// Allow the output to replace the input file or one of its companion files.
+    /// Default: `false`.
+    pub overwrite_input: bool,
+    /// The file the document was read from, to refuse overwriting it. Default: none.
+    pub input: Option<PathBuf>,
+}
+
+impl WriteOptions {
+    /// Options that refuse to overwrite `input` unless `overwrite_input` is set.
+    pub fn new(input: Option<PathBuf>, overwrite_input: bool) -> Self {
+        Self {
+            input,
+            overwrite_input,
+        }
+    }
+}
+
+/// Writes `doc` to `path` (`.glb`, or `.gltf` + `<stem>.bin`).
+pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
+    let shown = path.display().to_string();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let as_glb = match ext.as_deref() {
+        Some("glb") => true,
+        Some("gltf") => false,
+        _ => {
+            return Err(Error::invalid(
+                &shown,
+                "output name must end in .glb or .gltf",
+            ))
+        }
+    };
+    let bin_path = (!as_glb).then(|| path.with_extension("bin"));
+    refuse_overwriting_input(doc, path, bin_path.as_deref(), opts)?;
+    let out_dir = parent_dir(path);
+    let embed_images = !same_dir(doc.base_dir.as_deref(), out_dir);
+    let (json, bin) = assemble(doc, embed_images, bin_path.as_deref())?;
+    if as_glb {
+        let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
+        atomic_write(path, &glb::assemble(&text, &bin))
+    } else {
+        let mut text = serde_json::to_vec_pretty(&json).map_err(|e| Error::invalid(&shown, e))?;
+        text.push(b'\n');
+        if let Some(bin_path) = bin_path.filter(|_| !bin.is_empty()) {
+            atomic_write(&bin_path, &bin)?;
+        }
+        atomic_write(path, &text)
+    }
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+fn same_dir(a: Option<&Path>, b: &Path) -> bool {
+    let canon = |p: &Path| std::fs::canonicalize(p).ok();
+    a.is_some_and(|a| canon(a).is_some() && canon(a) == canon(b))
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Refuses to replace the input, or a buffer or image file it refers to, unless forced.
+fn refuse_overwriting_input(
+    doc: &Document,
+    path: &Path,
+    bin: Option<&Path>,
+    opts: &WriteOptions,
+) -> Result<()> {
+    if opts.overwrite_input {
+        return Ok(());
+    }
+    let mut inputs: Vec<PathBuf> = opts.input.iter().cloned().collect();
+    let uris = ["buffers", "images"]
+        .iter()
+        .flat_map(|k| {
+            doc.raw
+                .get(*k)
+                .and_then(Value::as_array)
+                .into_iter()
+                .flatten()
+        })
+        .filter_map(|o| o.get("uri").and_then(Value::as_str));
+    for u in uris {
+        if let Ok(uri::Target::File(f)) = uri::resolve(u, "uri", doc.base_dir.as_deref(), true) {
+            inputs.push(f);
+        }
+    }
+    for out in std::iter::once(path).chain(bin) {
+        if let Some(input) = inputs.iter().find(|i| same_file(i, out)) {
+            return Err(Error::invalid(
+                out.display(),
+                format!(
+                    "would overwrite the input {} (pass --force to allow it)",
+                    input.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Writes `bytes` to a temporary file in `path`'s folder, then renames it over `path`.
+pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
+    let shown = path.display().to_string();
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".g2tess-").suffix(".tmp");
+    // Temporary files are private (0600); the finished output gets the usual permissions.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder
+        .tempfile_in(parent_dir(path))
+        .map_err(|e| Error::io(&shown, e))?;
+    tmp.write_all(bytes).map_err(|e| Error::io(&shown, e))?;
+    tmp.as_file().sync_all().map_err(|e| Error::io(&shown, e))?;
+    tmp.persist(path).map_err(|e| Error::io(&shown, e.error))?;
+    Ok(())
+}
+
+/// Builds the output JSON and its single binary buffer.
+fn assemble(
+    doc: &Document,
+    embed_images: bool,
+    bin_path: Option<&Path>,
+) -> Result<(Value, Vec<u8>)> {
+    let now = serde_json::to_value(&doc.root).map_err(|e| Error::invalid("json", e))?;
+    let mut out = json_merge::merge(&doc.base, &now, &doc.raw);
+    let root = out
+        .as_object_mut()
+        .ok_or_else(|| Error::invalid("json", "top level is not an object"))?;
+    for ((m, p), prim) in &doc.replaced {
+        root["meshes"][*m]["primitives"][*p] = prim.clone();
+    }
+
+    // Which accessors and views survive.
+    let mut referenced = BTreeSet::new();
+    for_each_accessor_ref(root, &mut |i| {
+        referenced.insert(*i as usize);
+    });
+    // References inside extensions were never validated by the typed model: check them here.
+    if let Some(bad) = referenced.iter().find(|i| **i >= doc.root.accessors.len()) {
+        return Err(Error::invalid(
+            "json",
+            format!(
+                "a reference to accessor {bad}, which does not exist (expected an index below {})",
+                doc.root.accessors.len()
+            ),
+        ));
+    }
+    let mut bad_view = None;
+    for_each_view_ref(root, &mut |v| {
+        if *v as usize >= doc.root.buffer_views.len() {
+            bad_view = Some(*v);
+        }
+    });
+    if let Some(bad) = bad_view {
+        return Err(Error::invalid(
+            "json",
+            format!("a reference to buffer view {bad}, which does not exist (expected an index below {})", doc.root.buffer_views.len()),
+        ));
+    }
+    let keep_accessor: Vec<bool> = (0..doc.root.accessors.len())
+        .map(|i| referenced.contains(&i) || !doc.replaced_accessors.contains(&i))
+        .collect();
+    let accessor_views = |a: &gltf_json::Accessor| {
+        let sparse = a
+            .sparse
+            .iter()
+            .flat_map(|s| [s.indices.buffer_view.value(), s.values.buffer_view.value()]);
+        a.buffer_view
+            .map(|v| v.value())
+            .into_iter()
+            .chain(sparse)
+            .collect::<Vec<_>>()
+    };
+    let mut view_used = vec![false; doc.root.buffer_views.len()];
+    let mut view_orphaned = vec![false; doc.root.buffer_views.len()];
+    for (i, a) in doc.root.accessors.iter().enumerate() {
+        for v in accessor_views(a) {
+            if keep_accessor[i] {
+                view_used[v] = true;
+            } else {
+                view_orphaned[v] = true;
+            }
+        }
+    }
+    for_each_view_ref(root, &mut |v| view_used[*v as usize] = true);
+    let keep_view: Vec<bool> = view_used
+        .iter()
+        .zip(&view_orphaned)
+        .map(|(u, o)| *u || !*o)
+        .collect();
+
+    // Repack every kept view into one buffer.
+    let typed_views = now
+        .get("bufferViews")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let mut bin = Vec::new();
+    let mut views = Vec::new();
+    let mut view_map = vec![None; keep_view.len()];
+    for (i, keep) in keep_view.iter().enumerate() {
+        if !*keep {
+            continue;
+        }
+        let bytes = doc.view_bytes(i)?;
+        let mut v = typed_views[i].clone();
+        align4(&mut bin);
+        v["buffer"] = json!(0);
+        v["byteOffset"] = json!(bin.len());
+        v["byteLength"] = json!(bytes.len());
+        bin.extend_from_slice(bytes);
+        view_map[i] = Some(views.len());
+        views.push(v);
+    }
+    let typed_accessors = now
+        .get("accessors")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let mut accessors = Vec::new();
+    let mut accessor_map = vec![None; keep_accessor.len()];
+    for (i, keep) in keep_accessor.iter().enumerate() {
+        if !*keep {
+            continue;
+        }
+        let mut a = typed_accessors[i].clone();
+        for ptr in [
+            "/bufferView",
+            "/sparse/indices/bufferView",
+            "/sparse/values/bufferView",
+        ] {
+            if let Some(v) = a.pointer_mut(ptr) {
+                *v = json!(view_map[v.as_u64().unwrap_or(0) as usize]);
+            }
+        }
+        accessor_map[i] = Some(accessors.len());
+        accessors.push(a);
+    }
+    for_each_accessor_ref(root, &mut |i| {
+        *i = accessor_map[*i as usize].unwrap_or(0) as u64
+    });
+    for_each_view_ref(root, &mut |v| {
+        *v = view_map[*v as usize].unwrap_or(0) as u64
+    });
+
+    if embed_images {
+        embed_external_images(doc, root, &mut bin, &mut views)?;
+    }
+    set_array(root, "accessors", accessors);
+    set_array(root, "bufferViews", views);
+    let buffers = if bin.is_empty() {
+        vec![]
+    } else {
+        align4(&mut bin);
+        let mut b = json!({ "byteLength": bin.len() });
+        if let Some(name) = bin_path.and_then(Path::file_name).and_then(|n| n.to_str()) {
+            b["uri"] = json!(percent_encoding::utf8_percent_encode(name, URI_ESCAPES).to_string());
+        }
+        vec![b]
+    };
+    set_array(root, "buffers", buffers);
+    fix_extension_lists(root);
+    Ok((out, bin))
+}
+
+/// Characters escaped in a written file name `uri` (RFC 3986 reserved and unsafe ones).
+const URI_ESCAPES: &percent_encoding::AsciiSet = &percent_encoding::CONTROLS
+    .add(b' ')
+    .add(b'"')
+    .add(b'#')
+    .add(b'%')
+    .add(b'<')
+    .add(b'>')
+    .add(b'?')
+    .add(b'[')
+    .add(b'\\')
+    .add(b']')
+    .add(b'^')
+    .add(b'`')
+    .add(b'{')
+    .add(b'|')
+    .add(b'}')
+    .add(b':');
+
+fn align4(bin: &mut Vec<u8>) {
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+}
+
+fn set_array(root: &mut Map<String, Value>, key: &str, items: Vec<Value>) {
+    if items.is_empty() {
+        root.remove(key);
+    } else {
+        root.insert(key.into(), Value::Array(items));
+    }
+}
+
+fn arr<'a>(root: &'a mut Map<String, Value>, key: &str) -> impl Iterator<Item = &'a mut Value> {
+    root.get_mut(key)
+        .and_then(Value::as_array_mut)
+        .into_iter()
+        .flatten()
+}
+
+fn visit_u64(v: Option<&mut Value>, f: &mut dyn FnMut(&mut u64)) {
+    if let Some(v) = v {
+        if let Some(mut i) = v.as_u64() {
+            f(&mut i);
+            *v = json!(i);
+        }
+    }
+}
+
+fn visit_values(v: Option<&mut Value>, f: &mut dyn FnMut(&mut u64)) {
+    for x in v
+        .and_then(Value::as_object_mut)
+        .into_iter()
+        .flat_map(|o| o.values_mut())
+    {
+        visit_u64(Some(x), f);
+    }
+}
+
+/// Calls `f` on every accessor index the JSON holds (in places this writer knows about).
+fn for_each_accessor_ref(root: &mut Map<String, Value>, f: &mut dyn FnMut(&mut u64)) {
+    for mesh in arr(root, "meshes") {
+        for prim in mesh
+            .get_mut("primitives")
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
+            visit_values(prim.get_mut("attributes"), f);
+            visit_u64(prim.get_mut("indices"), f);
+            for t in prim
+                .get_mut("targets")
+                .and_then(Value::as_array_mut)
+                .into_iter()
+                .flatten()
+            {
+                visit_values(Some(t), f);
+            }
+        }
+    }
+    for skin in arr(root, "skins") {
+        visit_u64(skin.get_mut("inverseBindMatrices"), f);
+    }
+    for anim in arr(root, "animations") {
+        for s in anim
+            .get_mut("samplers")
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
+            visit_u64(s.get_mut("input"), f);
+            visit_u64(s.get_mut("output"), f);
+        }
+    }
+    for node in arr(root, "nodes") {
+        visit_values(
+            node.pointer_mut("/extensions/EXT_mesh_gpu_instancing/attributes"),
+            f,
+        );
+    }
+}
+
+/// Calls `f` on every buffer view index outside accessors (images, Draco primitives).
+fn for_each_view_ref(root: &mut Map<String, Value>, f: &mut dyn FnMut(&mut u64)) {
+    for image in arr(root, "images") {
+        visit_u64(image.get_mut("bufferView"), f);
+    }
+    for mesh in arr(root, "meshes") {
+        for prim in mesh
+            .get_mut("primitives")
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
+            visit_u64(
+                prim.pointer_mut("/extensions/KHR_draco_mesh_compression/bufferView"),
+                f,
+            );
+        }
+    }
+}
+
+/// Moves images stored as separate files into the output's buffer, because their relative
+/// `uri`s would not resolve from the output's folder. Network `uri`s are kept as they are.
+fn embed_external_images(
+    doc: &Document,
+    root: &mut Map<String, Value>,
+    bin: &mut Vec<u8>,
+    views: &mut Vec<Value>,
+) -> Result<()> {
+    for (i, image) in arr(root, "images").enumerate() {
+        let Some(u) = image.get("uri").and_then(Value::as_str).map(str::to_owned) else {
+            continue;
+        };
+        let at = format!("images[{i}].uri");
+        let target = match uri::resolve(&u, &at, doc.base_dir.as_deref(), doc.allow_outside_uris) {
+            Ok(uri::Target::File(f)) => f,
+            Ok(uri::Target::Data(_)) => continue,
+            Err(_) if u.contains("://") => continue,
+            Err(e) => return Err(e),
+        };
+        let bytes = std::fs::read(&target)
+            .map_err(|e| Error::io(format!("{at} ({})", target.display()), e))?;
+        let mime = image
+            .get("mimeType")
+            .and_then(Value::as_str)
+            .map(str::to_owned)
+            .or_else(|| mime_of(&target, &bytes))
+            .ok_or_else(|| {
+                Error::invalid(
+                    &at,
+                    "cannot tell the image's type to embed it (expected png, jpeg, webp or ktx2)",
+                )
+            })?;
+        align4(bin);
+        views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() }));
+        bin.extend_from_slice(&bytes);
+        let obj = image.as_object_mut().expect("images are objects");
+        obj.remove("uri");
+        obj.insert("bufferView".into(), json!(views.len() - 1));
+        obj.insert("mimeType".into(), json!(mime));
+    }
+    Ok(())
+}
+
+fn mime_of(path: &Path, bytes: &[u8]) -> Option<String> {
+    let by_magic = if bytes.starts_with(b"\x89PNG") {
+        Some("image/png")
+    } else if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
+        Some("image/jpeg")
+    } else if bytes.len() > 12 && &bytes[8..12] == b"WEBP" {
+        Some("image/webp")
+    } else if bytes.starts_with(b"\xABKTX 20") {
+        Some("image/ktx2")
+    } else {
+        None
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    by_magic
+        .or(match ext.as_deref() {
+            Some("png") => Some("image/png"),
+            Some("jpg" | "jpeg") => Some("image/jpeg"),
+            Some("webp") => Some("image/webp"),
+            Some("ktx2") => Some("image/ktx2"),
+            _ => None,
+        })
+        .map(str::to_owned)
+}
+
+/// Keeps `extensionsUsed`/`extensionsRequired` true to what is written: meshopt compression is
+/// decoded on read, and KHR_mesh_quantization is only needed while quantized attributes remain.
+fn fix_extension_lists(root: &mut Map<String, Value>) {
+    let quantized = uses_quantized_attributes(root);
+    for key in ["extensionsUsed", "extensionsRequired"] {
+        if let Some(list) = root.get_mut(key).and_then(Value::as_array_mut) {
+            list.retain(|e| {
+                let name = e.as_str().unwrap_or("");
+                !meshopt_decode::EXTENSIONS.contains(&name)
+                    && (quantized || name != "KHR_mesh_quantization")
+            });
+            if list.is_empty() {
+                root.remove(key);
+            }
+        }
+    }
+    for buffer in arr(root, "buffers") {
+        if let Some(ext) = buffer.get_mut("extensions").and_then(Value::as_object_mut) {
+            for n in meshopt_decode::EXTENSIONS {
+                ext.remove(n);
+            }
+        }
+    }
+}
+
+/// Does any primitive attribute still use a format only KHR_mesh_quantization allows?
+fn uses_quantized_attributes(root: &mut Map<String, Value>) -> bool {
+    let accessors = root
+        .get("accessors")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let format = |i: u64| {
+        let a = &accessors[i as usize];
+        (
+            a["componentType"].as_u64().unwrap_or(5126),
+            a["normalized"].as_bool().unwrap_or(false),
+        )
+    };
+    let mut found = false;
+    let meshes = root
+        .get("meshes")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    for prim in meshes
+        .iter()
+        .filter_map(|m| m["primitives"].as_array())
+        .flatten()
+    {
+        let targets = prim["targets"].as_array().cloned().unwrap_or_default();
+        let sets =
+            std::iter::once((&prim["attributes"], false)).chain(targets.iter().map(|t| (t, true)));
+        for (set, is_target) in sets {
+            for (name, i) in set.as_object().into_iter().flatten() {
+                let Some(i) = i.as_u64() else { continue };
+                let (ct, normalized) = format(i);
+                let core = match name.as_str() {
+                    "POSITION" | "NORMAL" | "TANGENT" => ct == 5126,
+                    n if n.starts_with("TEXCOORD_") => {
+                        ct == 5126 || (normalized && (ct == 5121 || ct == 5123))
+                    }
+                    _ => true,
+                };
+                found |= !core || (is_target && ct != 5126 && !name.starts_with('_'));
+            }
+        }
+    }
+    found
+}

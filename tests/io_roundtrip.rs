@@ -1,0 +1,328 @@
+//! Every real asset in `../shared/fixtures-real/valid/` read, run through the identity
+//! tessellation and written back as .gltf and as .glb: nothing lost, geometry bit-exact, and the
+//! Khronos validator clean on every output whose input it finds clean.
+
+mod corpus;
+
+use std::path::{Path, PathBuf};
+
+use g2tess::gltf_io::{self, Document, ReadOptions, Values, WriteOptions};
+use g2tess::options::Options;
+use serde_json::Value;
+
+/// Inputs the reader must refuse: Draco geometry cannot be decoded.
+const EXPECTED_UNSUPPORTED: [&str; 3] = [
+    "2CylinderEngine.gltf",
+    "BoxDraco.gltf",
+    "DracoSparseMesh.gltf",
+];
+
+fn is_expected_unsupported(p: &Path) -> bool {
+    EXPECTED_UNSUPPORTED.iter().any(|n| p.ends_with(n)) && p.to_string_lossy().contains("Draco")
+}
+
+/// The input's JSON as written in the file.
+fn raw_json(path: &Path) -> Value {
+    let bytes = std::fs::read(path).unwrap();
+    let json = if bytes.starts_with(b"glTF") {
+        let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        bytes[20..20 + len].to_vec()
+    } else {
+        bytes
+    };
+    serde_json::from_slice(&json).unwrap()
+}
+
+/// The JSON with what the writer legitimately rewrites taken out: accessors, views and
+/// buffers; accessor and view indices; images' storage; primitives' geometry references;
+/// the compression and quantization extensions it decodes.
+fn comparable(mut v: Value) -> Value {
+    let root = v.as_object_mut().unwrap();
+    for key in ["accessors", "bufferViews", "buffers"] {
+        root.remove(key);
+    }
+    for key in ["extensionsUsed", "extensionsRequired"] {
+        if let Some(list) = root.get_mut(key).and_then(Value::as_array_mut) {
+            list.retain(|e| {
+                !matches!(
+                    e.as_str(),
+                    Some(
+                        "EXT_meshopt_compression"
+                            | "KHR_meshopt_compression"
+                            | "KHR_mesh_quantization"
+                    )
+                )
+            });
+            if list.is_empty() {
+                root.remove(key);
+            }
+        }
+    }
+    let each = |root: &mut serde_json::Map<String, Value>,
+                key: &str,
+                f: &mut dyn FnMut(&mut serde_json::Map<String, Value>)| {
+        for item in root
+            .get_mut(key)
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
+            f(item.as_object_mut().unwrap());
+        }
+    };
+    each(root, "images", &mut |i| {
+        for k in ["uri", "bufferView", "mimeType"] {
+            i.remove(k);
+        }
+    });
+    each(root, "skins", &mut |s| {
+        s.remove("inverseBindMatrices");
+    });
+    each(root, "animations", &mut |a| {
+        for s in a
+            .get_mut("samplers")
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
+            s["input"] = Value::Null;
+            s["output"] = Value::Null;
+        }
+    });
+    each(root, "nodes", &mut |n| {
+        if let Some(a) = n
+            .get_mut("extensions")
+            .and_then(|e| e.get_mut("EXT_mesh_gpu_instancing"))
+        {
+            a["attributes"] = Value::Null;
+        }
+    });
+    each(root, "meshes", &mut |m| {
+        for p in m
+            .get_mut("primitives")
+            .and_then(Value::as_array_mut)
+            .into_iter()
+            .flatten()
+        {
+            let p = p.as_object_mut().unwrap();
+            let names: Vec<String> = p
+                .get("attributes")
+                .and_then(Value::as_object)
+                .map(|o| o.keys().cloned().collect())
+                .unwrap_or_default();
+            p.insert("attributes".into(), names.into());
+            let targets = p
+                .get("targets")
+                .and_then(Value::as_array)
+                .map_or(0, Vec::len);
+            p.insert("targets".into(), targets.into());
+            p.remove("indices");
+            let mode = p.remove("mode").and_then(|m| m.as_u64()).unwrap_or(4);
+            p.insert(
+                "mode".into(),
+                (if (4..=6).contains(&mode) { 4 } else { mode }).into(),
+            );
+        }
+    });
+    v
+}
+
+/// The JSON path and values of the first difference between `a` and `b`.
+fn first_difference(a: &Value, b: &Value, path: String) -> Option<String> {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            for k in x.keys().chain(y.keys()) {
+                let (u, v) = (
+                    x.get(k).unwrap_or(&Value::Null),
+                    y.get(k).unwrap_or(&Value::Null),
+                );
+                if let Some(d) = first_difference(u, v, format!("{path}.{k}")) {
+                    return Some(d);
+                }
+            }
+            None
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+            .iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(i, (u, v))| first_difference(u, v, format!("{path}[{i}]"))),
+        _ if a == b => None,
+        _ => Some(format!("{path}: {a} became {b}")),
+    }
+}
+
+/// Every `extras` value with its JSON path.
+fn extras(v: &Value, path: String, out: &mut Vec<(String, Value)>) {
+    match v {
+        Value::Object(o) => {
+            for (k, x) in o {
+                if k == "extras" {
+                    out.push((path.clone(), x.clone()));
+                }
+                extras(x, format!("{path}.{k}"), out);
+            }
+        }
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, x)| extras(x, format!("{path}[{i}]"), out)),
+        _ => {}
+    }
+}
+
+fn floats(doc: &Document, m: usize, p: usize, name: &str) -> Option<Vec<u32>> {
+    let data = doc.read_primitive(m, p).unwrap();
+    match &data.attribute(name)?.values {
+        Values::Float(v) => Some(v.iter().map(|x| x.to_bits()).collect()),
+        Values::Uint(v) => Some(v.clone()),
+    }
+}
+
+/// Identity: same positions and normals bit for bit, same triangles, for every triangle primitive.
+fn assert_same_geometry(input: &Document, output: &Document, name: &str) {
+    assert_eq!(
+        input.triangle_primitives(),
+        output.triangle_primitives(),
+        "{name}: triangle primitives"
+    );
+    for (m, p) in input.triangle_primitives() {
+        for attr in ["POSITION", "NORMAL"] {
+            assert_eq!(
+                floats(input, m, p, attr),
+                floats(output, m, p, attr),
+                "{name}: meshes[{m}].primitives[{p}] {attr}"
+            );
+        }
+        let a = input.read_primitive(m, p).unwrap();
+        let b = output.read_primitive(m, p).unwrap();
+        assert_eq!(
+            a.indices, b.indices,
+            "{name}: meshes[{m}].primitives[{p}] triangles"
+        );
+        assert_eq!(
+            a.attributes.len(),
+            b.attributes.len(),
+            "{name}: attribute count"
+        );
+        assert_eq!(a.targets, b.targets, "{name}: morph targets");
+        for (x, y) in a.attributes.iter().zip(&b.attributes) {
+            assert_eq!(
+                (&x.name, &x.values),
+                (&y.name, &y.values),
+                "{name}: attribute {}",
+                x.name
+            );
+        }
+    }
+}
+
+#[test]
+fn every_valid_asset_round_trips_without_loss() {
+    let Some(corpus) = corpus::fixtures_real() else {
+        return;
+    };
+    let out_dir = corpus::temp_dir();
+    let opts = Options::default();
+    let mut inputs_written: Vec<(PathBuf, Vec<PathBuf>)> = Vec::new();
+    for (n, input) in corpus::gltf_files(&corpus.join("valid"))
+        .iter()
+        .enumerate()
+    {
+        let name = input.strip_prefix(&corpus).unwrap().display().to_string();
+        let doc = gltf_io::read(input, &ReadOptions::default());
+        if is_expected_unsupported(input) {
+            let mut doc = doc.unwrap_or_else(|e| panic!("{name}: {e}"));
+            let err = g2tess::pipeline::process_document(&mut doc, &opts).unwrap_err();
+            assert!(
+                err.to_string().contains("KHR_draco_mesh_compression"),
+                "{name}: {err}"
+            );
+            continue;
+        }
+        let doc = doc.unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut processed = doc.clone();
+        g2tess::pipeline::process_document(&mut processed, &opts)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut outputs = Vec::new();
+        for ext in ["gltf", "glb"] {
+            // One folder per output, so .bin names never collide.
+            let dir = out_dir.path().join(format!("{n:03}-{ext}"));
+            std::fs::create_dir(&dir).unwrap();
+            let out = dir.join(format!(
+                "{}.{ext}",
+                input.file_stem().unwrap().to_string_lossy()
+            ));
+            gltf_io::write(&processed, &out, &WriteOptions::default())
+                .unwrap_or_else(|e| panic!("{name} -> {ext}: {e}"));
+            let back = gltf_io::read(&out, &ReadOptions::default())
+                .unwrap_or_else(|e| panic!("{name} -> {ext} read back: {e}"));
+            assert_same_geometry(&doc, &back, &name);
+
+            let (before, after) = (raw_json(input), raw_json(&out));
+            let (mut eb, mut ea) = (Vec::new(), Vec::new());
+            extras(&comparable(before.clone()), String::new(), &mut eb);
+            extras(&comparable(after.clone()), String::new(), &mut ea);
+            assert_eq!(eb, ea, "{name} -> {ext}: extras");
+            for key in [
+                "nodes",
+                "meshes",
+                "materials",
+                "animations",
+                "skins",
+                "images",
+                "textures",
+                "cameras",
+            ] {
+                let count = |v: &Value| v.get(key).and_then(Value::as_array).map_or(0, Vec::len);
+                assert_eq!(
+                    count(&before),
+                    count(&after),
+                    "{name} -> {ext}: number of {key}"
+                );
+            }
+            let diff = first_difference(&comparable(before), &comparable(after), String::new());
+            assert_eq!(
+                diff, None,
+                "{name} -> {ext}: JSON outside the rewritten geometry"
+            );
+            outputs.push(out);
+        }
+        inputs_written.push((input.clone(), outputs));
+    }
+    assert!(
+        inputs_written.len() >= 50,
+        "only {} assets round-tripped",
+        inputs_written.len()
+    );
+
+    let inputs: Vec<&Path> = inputs_written.iter().map(|(i, _)| i.as_path()).collect();
+    let Some(before) = corpus::validate(&inputs) else {
+        return;
+    };
+    let Some(after) = corpus::validate(&[out_dir.path()]) else {
+        return;
+    };
+    let mut clean = 0;
+    for (input, outputs) in &inputs_written {
+        let verdict_in = &before[input];
+        for out in outputs {
+            let verdict_out = &after[out];
+            if verdict_in.errors == 0 {
+                assert_eq!(
+                    verdict_out.errors,
+                    0,
+                    "{} -> {}: validator errors {:?}",
+                    input.display(),
+                    out.display(),
+                    verdict_out.codes
+                );
+            }
+            clean += usize::from(verdict_out.errors == 0);
+        }
+    }
+    eprintln!(
+        "{clean} of {} outputs validate without errors",
+        inputs_written.len() * 2
+    );
+}
