@@ -161,7 +161,7 @@ impl ConfigFile {
     /// Parses TOML text; `origin` names it in errors (`file.toml:12: …`).
     pub fn parse(text: &str, origin: &str) -> Result<Self, ConfigError> {
         toml::from_str(text).map_err(|e: toml::de::Error| {
-            let line = e.span().map(|s| text[..s.start].lines().count().max(1));
+            let line = e.span().map(|s| text[..s.start].matches('\n').count() + 1);
             ConfigError {
                 at: line.map_or(origin.to_string(), |l| format!("{origin}:{l}")),
                 what: e.message().to_lowercase(),

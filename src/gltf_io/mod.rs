@@ -12,7 +12,7 @@
 //! - [`validate`]: what the spec calls an error, refused at read time
 //! - [`primitive`]: [`PrimitiveData`] out of and back into a document
 //! - [`json_merge`]: keeps what the typed JSON model loses
-//! - [`write`]: `.glb` or `.gltf` + `.bin`, atomically
+//! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically
 //! - [`error`]: [`Error`], located by JSON path
 
 pub mod accessor;

@@ -134,9 +134,15 @@ fn refuse_overwriting_input(
 /// Writes `bytes` to a temporary file in `path`'s folder, then renames it over `path`.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
     let shown = path.display().to_string();
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".g2tess-")
-        .suffix(".tmp")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".g2tess-").suffix(".tmp");
+    // Temporary files are private (0600); the finished output gets the usual permissions.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder
         .tempfile_in(parent_dir(path))
         .map_err(|e| Error::io(&shown, e))?;
     tmp.write_all(bytes).map_err(|e| Error::io(&shown, e))?;
@@ -165,6 +171,28 @@ fn assemble(
     for_each_accessor_ref(root, &mut |i| {
         referenced.insert(*i as usize);
     });
+    // References inside extensions were never validated by the typed model: check them here.
+    if let Some(bad) = referenced.iter().find(|i| **i >= doc.root.accessors.len()) {
+        return Err(Error::invalid(
+            "json",
+            format!(
+                "a reference to accessor {bad}, which does not exist (expected an index below {})",
+                doc.root.accessors.len()
+            ),
+        ));
+    }
+    let mut bad_view = None;
+    for_each_view_ref(root, &mut |v| {
+        if *v as usize >= doc.root.buffer_views.len() {
+            bad_view = Some(*v);
+        }
+    });
+    if let Some(bad) = bad_view {
+        return Err(Error::invalid(
+            "json",
+            format!("a reference to buffer view {bad}, which does not exist (expected an index below {})", doc.root.buffer_views.len()),
+        ));
+    }
     let keep_accessor: Vec<bool> = (0..doc.root.accessors.len())
         .map(|i| referenced.contains(&i) || !doc.replaced_accessors.contains(&i))
         .collect();

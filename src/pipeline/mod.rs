@@ -129,13 +129,10 @@ fn raw_extras(doc: &Document, collection: &[&str], index: usize) -> Option<Value
 /// normal texture (a renderer would otherwise derive them per pixel from screen derivatives,
 /// which no longer match a bake against the low-poly mesh).
 fn needs_tangents(doc: &Document, mesh: usize, prim: usize, data: &PrimitiveData) -> Option<u32> {
-    let material = doc.root.meshes[mesh].primitives[prim].material?;
-    let normal_texture = doc
-        .root
-        .materials
-        .get(material.value())?
-        .normal_texture
-        .as_ref();
+    let normal_texture = doc.root.meshes[mesh].primitives[prim]
+        .material
+        .and_then(|m| doc.root.materials.get(m.value()))
+        .and_then(|m| m.normal_texture.as_ref());
     match normal_texture {
         Some(t) => Some(t.tex_coord),
         None if data.attribute("TANGENT").is_some() => Some(0),

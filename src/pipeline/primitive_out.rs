@@ -229,6 +229,20 @@ pub fn build(
     let base_tangents = uvs
         .as_ref()
         .map(|uv| tangents::generate(&dense.positions, &normals, uv, &dense.indices));
+    let base_tangents = base_tangents.or_else(|| {
+        // Tangents without the texture coordinates to regenerate them: carry them and make
+        // them perpendicular to the new normals again.
+        let input = prep.data.attribute("TANGENT")?;
+        let Values::Float(v) = carry_one(input, tris, dense).values else {
+            return None;
+        };
+        (input.components == 4).then(|| {
+            v.chunks_exact(4)
+                .zip(&normals)
+                .map(|(t, n)| reorthogonalize([t[0], t[1], t[2], t[3]], *n))
+                .collect::<Vec<_>>()
+        })
+    });
     if let Some(t) = &base_tangents {
         attributes.push(float_attribute(
             "TANGENT",
@@ -236,6 +250,19 @@ pub fn build(
             t.iter().flatten().copied().collect(),
         ));
     }
+
+    // Attributes keep the input's order (tools and diffs read it); new ones follow.
+    let rank = |name: &str| -> usize {
+        let input = &prep.data.attributes;
+        match input.iter().position(|a| a.name == name) {
+            Some(i) => 2 * i,
+            None if name == "NORMAL" => {
+                2 * input.iter().position(|a| a.name == "POSITION").unwrap_or(0) + 1
+            }
+            None => usize::MAX,
+        }
+    };
+    attributes.sort_by_key(|a| rank(&a.name));
 
     let targets = prep
         .data
@@ -259,6 +286,14 @@ pub fn build(
         indices: dense.indices.clone(),
         targets,
     }
+}
+
+/// `t` made unit length and perpendicular to `n`, with its handedness `w` kept as ±1.
+fn reorthogonalize(t: [f32; 4], n: [f32; 3]) -> [f32; 4] {
+    let n = glam::Vec3::from(n);
+    let v = glam::Vec3::new(t[0], t[1], t[2]);
+    let v = (v - n * n.dot(v)).normalize_or(n.any_orthonormal_vector());
+    [v.x, v.y, v.z, if t[3] < 0.0 { -1.0 } else { 1.0 }]
 }
 
 fn skin_sets_has(prep: &Prepared, weights_name: &str) -> bool {

@@ -9,7 +9,7 @@
 //!
 //! Two triangles that share a welded edge take the positions of its samples from one evaluation
 //! (the edge's lowest-numbered triangle, in the edge's canonical direction), and a corner's
-//! position is the welded input vertex itself. Positions along a shared edge are therefore
+//! position is the input vertex's own. Positions along a shared edge are therefore
 //! bit-identical on both sides, whatever the surface scheme and whatever the rounding of either
 //! side's own evaluation.
 //!
@@ -235,15 +235,15 @@ fn tessellate_group(
     for (offset, tri) in range.clone().enumerate() {
         lattice.clear();
         surface.evaluate_lattice(tri, n, &mut lattice);
-        let welded = topo.tri_verts[tri];
         for j in 0..=n {
             for i in 0..=(n - j) {
                 let li = lattice_index(n, i, j);
                 let (slot, position) = match SampleKind::of(n, i, j) {
                     SampleKind::Corner(c) => {
+                        // The vertex's own position, not its welded representative: welding
+                        // equates -0.0 and +0.0, and the input's bits are kept.
                         let v = mesh.triangles[tri][c];
-                        let p = topo.welded_positions[welded[c].0 as usize];
-                        (corner_out[v as usize] as usize, p)
+                        (corner_out[v as usize] as usize, mesh.positions[v as usize])
                     }
                     SampleKind::Edge { k, m } => {
                         let half = offset * 3 + k;
