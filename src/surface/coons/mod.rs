@@ -32,7 +32,7 @@ pub mod patch;
 use glam::DVec3;
 
 use super::hybrid::{EdgeNets, PaperReading};
-use super::pn::{compose, Net};
+use super::pn::{compose, Net, IJK};
 use super::scheme::creases::{own_nets, smooth_edges, Corners};
 use super::scheme::{SchemeParams, Warning};
 use super::{blend, Surface, SurfacePoint};
@@ -65,9 +65,12 @@ pub enum NormalMethod {
 #[derive(Debug, Clone)]
 pub struct CoonsSurface {
     corners: Vec<Corners>,
-    /// `nets[t][k]`: triangle t's constituent for its edge opposite corner k.
+    /// `perm[t][c]`: the input corner of triangle t that is its canonical corner c.
+    perm: Vec<[usize; 3]>,
+    /// `nets[t][k]`: triangle t's constituent for its edge opposite canonical corner k, in
+    /// canonical barycentrics.
     nets: Vec<[Net; 3]>,
-    /// `(λ1, λ2, λ3)` per triangle.
+    /// `(λ1, λ2, λ3)` per triangle, in canonical order.
     lambda: Vec<[f64; 3]>,
     smooth: Vec<bool>,
     warnings: Vec<Warning>,
@@ -105,6 +108,15 @@ impl CoonsSurface {
                 (e.corners, e.nets, e.smooth, e.warnings)
             }
         };
+        let perm: Vec<[usize; 3]> = corners
+            .iter()
+            .map(|c| canonical_order(c.position))
+            .collect();
+        let nets: Vec<[Net; 3]> = nets
+            .iter()
+            .zip(&perm)
+            .map(|(r, p)| p.map(|k| permute_net(&r[k], *p)))
+            .collect();
         let (lo, hi) = Self::LAMBDA_RANGE;
         let start = if params.lambda.is_nan() {
             SchemeParams::DEFAULT_LAMBDA
@@ -120,6 +132,7 @@ impl CoonsSurface {
         };
         CoonsSurface {
             corners,
+            perm,
             nets,
             lambda,
             smooth,
@@ -157,13 +170,42 @@ impl CoonsSurface {
     }
 
     fn position(&self, tri: usize, l: [f64; 3]) -> DVec3 {
-        DVec3::from_array(patch::point(
-            &self.nets[tri],
-            self.lambda[tri],
-            l,
-            self.definition,
-        ))
+        let x = self.perm[tri].map(|c| l[c]);
+        let f = patch::point(&self.nets[tri], self.lambda[tri], x, self.definition);
+        DVec3::from_array(f)
     }
+}
+
+/// The corners of a triangle sorted by position (lexicographic, total order): the Coons patch
+/// is invariant under cyclic relabelling but not under reflection (its auxiliary curves are
+/// projected in one rotational sense), so it is always built in this order, which does not
+/// depend on the input's corner order or winding.
+fn canonical_order(p: [DVec3; 3]) -> [usize; 3] {
+    let key = |c: usize| p[c].to_array();
+    let mut order = [0, 1, 2];
+    order.sort_by(|&a, &b| {
+        let (ka, kb) = (key(a), key(b));
+        ka[0]
+            .total_cmp(&kb[0])
+            .then(ka[1].total_cmp(&kb[1]))
+            .then(ka[2].total_cmp(&kb[2]))
+    });
+    order
+}
+
+/// `net` re-expressed in barycentrics `x` with `x[c] = l[perm[c]]`: the point with exponents
+/// `e'` is the old point with exponents `e[perm[c]] = e'[c]`.
+fn permute_net(net: &Net, perm: [usize; 3]) -> Net {
+    std::array::from_fn(|m| {
+        let mut e = [0; 3];
+        for c in 0..3 {
+            e[perm[c]] = IJK[m][c];
+        }
+        net[IJK
+            .iter()
+            .position(|x| *x == e)
+            .expect("exponents sum to 3")]
+    })
 }
 
 type Built = (Vec<Corners>, Vec<[Net; 3]>, Vec<bool>, Vec<Warning>);
@@ -199,11 +241,9 @@ impl Surface for CoonsSurface {
         }
         let (position, du, dv) = match self.normals {
             NormalMethod::Analytic => {
-                let x = [
-                    Dual::new(l[0], [1.0, 0.0]),
-                    Dual::new(l[1], [0.0, 1.0]),
-                    Dual::new(l[2], [-1.0, -1.0]),
-                ];
+                // ∂_u and ∂_v of the input barycentrics, seeded into the canonical ones.
+                const SEED: [[f64; 2]; 3] = [[1.0, 0.0], [0.0, 1.0], [-1.0, -1.0]];
+                let x = self.perm[tri].map(|c| Dual::new(l[c], SEED[c]));
                 let f = patch::point(&self.nets[tri], self.lambda[tri], x, self.definition);
                 (
                     DVec3::new(f[0].v, f[1].v, f[2].v),

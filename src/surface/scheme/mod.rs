@@ -93,7 +93,6 @@ impl FromStr for Scheme {
 
 /// Parameters of the schemes that have any; each scheme reads only its own.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[non_exhaustive]
 pub struct SchemeParams {
     /// Blend profile of the G² scheme. Default value: [`Profile::C2`].
     pub profile: Profile,
