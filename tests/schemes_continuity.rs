@@ -128,3 +128,39 @@ fn plain_pn_jumps_by_more_than_a_degree_on_the_same_meshes() {
         assert!(r.normal_jump_deg.max > 1.0, "{name}: {r:?}");
     }
 }
+
+#[test]
+fn coons_stays_g1_for_any_lambda_and_with_fairing() {
+    let mesh = bumpy_sphere();
+    let topo = Topology::build(&mesh);
+    let h = h_all(&topo, 0.2);
+    for (lambda, fair) in [(0.2, false), (0.8, false), (0.5, true)] {
+        let params = SchemeParams {
+            lambda,
+            fair,
+            ..SchemeParams::default()
+        };
+        let s = CoonsSurface::new(&mesh, &topo, &h, &params);
+        if fair {
+            let range = CoonsSurface::FAIR_RANGE;
+            assert!(s
+                .lambda()
+                .iter()
+                .flatten()
+                .all(|l| *l >= range.0 && *l <= range.1));
+            assert!(
+                s.lambda().iter().flatten().any(|l| *l != 0.5),
+                "fairing moved λ"
+            );
+        }
+        let r = measure(&s, &topo);
+        println!(
+            "coons λ={lambda} fair={fair}: gap {:.1e} L, normal jump max {:.1e}°",
+            r.gap.max, r.normal_jump_deg.max
+        );
+        assert!(
+            r.gap.max <= GAP_TOL && r.normal_jump_deg.max < COONS_TOL,
+            "{r:?}"
+        );
+    }
+}

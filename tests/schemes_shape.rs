@@ -182,3 +182,33 @@ fn coons_finite_difference_normals_agree_with_analytic_ones() {
     println!("coons analytic vs finite-difference normals: worst {worst:.1e}°");
     assert!(worst < 1e-4, "{worst}");
 }
+
+#[test]
+fn fairing_lowers_the_thin_plate_energy_of_every_patch() {
+    use g2tess::surface::coons::fair::energy;
+    let mesh = torus(6);
+    let topo = Topology::build(&mesh);
+    let h = h_all(&topo, 0.2);
+    let plain = CoonsSurface::new(&mesh, &topo, &h, &SchemeParams::default());
+    let faired = CoonsSurface::new(
+        &mesh,
+        &topo,
+        &h,
+        &SchemeParams {
+            fair: true,
+            ..SchemeParams::default()
+        },
+    );
+    let (mut before, mut after) = (0.0, 0.0);
+    for t in 0..mesh.triangles.len() {
+        let r = plain.constituents(t);
+        let (b, a) = (energy(r, plain.lambda()[t]), energy(r, faired.lambda()[t]));
+        assert!(a <= b, "tri {t}: {a} > {b}");
+        (before, after) = (before + b, after + a);
+    }
+    println!("torus 6x6 thin-plate energy: λ = 0.5 {before:.1}, faired {after:.1}");
+    assert!(after < before);
+    let (d0, _) = distance(&plain, mesh.triangles.len(), Exact::Torus, 16);
+    let (d1, _) = distance(&faired, mesh.triangles.len(), Exact::Torus, 16);
+    println!("torus 6x6 max distance: λ = 0.5 {d0:.4}, faired {d1:.4}");
+}

@@ -159,6 +159,11 @@ impl CoonsSurface {
         &self.lambda
     }
 
+    /// Triangle `t`'s three constituent nets, in its canonical corner order.
+    pub fn constituents(&self, t: usize) -> &[Net; 3] {
+        &self.nets[t]
+    }
+
     /// Per welded edge: smooth (G¹) or a crease.
     pub fn smooth_edges(&self) -> &[bool] {
         &self.smooth
