@@ -26,7 +26,11 @@ fn bench(c: &mut Criterion) {
         constituents: Constituents::FoleyOpitz,
         ..d
     };
-    let coons = CoonsSurface::new(&mesh, &topo, &h, &d);
+    let pnavg = SchemeParams {
+        constituents: Constituents::PnAverage,
+        ..d
+    };
+    let coons = CoonsSurface::new(&mesh, &topo, &h, &pnavg);
     let surfaces: Vec<(&str, Box<dyn Surface>)> = vec![
         ("pn", build_surface(Scheme::Pn, &mesh, &topo, &h, &d).0),
         (
@@ -37,9 +41,9 @@ fn bench(c: &mut Criterion) {
             "hybrid",
             build_surface(Scheme::Hybrid, &mesh, &topo, &h, &d).0,
         ),
-        ("coons_analytic", Box::new(coons.clone())),
+        ("coons_pnavg_analytic", Box::new(coons.clone())),
         (
-            "coons_fd",
+            "coons_pnavg_fd",
             Box::new(coons.with_normals(NormalMethod::FiniteDifference)),
         ),
         (
@@ -74,7 +78,7 @@ fn bench(c: &mut Criterion) {
     for (name, scheme, params) in [
         ("g2", Scheme::G2, d),
         ("hybrid", Scheme::Hybrid, d),
-        ("coons", Scheme::Coons, d),
+        ("coons_pnavg", Scheme::Coons, pnavg),
         ("coons_fo", Scheme::Coons, fo),
     ] {
         group.bench_function(name, |b| {

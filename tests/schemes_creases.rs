@@ -24,9 +24,13 @@ fn schemes() -> Vec<(&'static str, Scheme, SchemeParams)> {
         constituents: Constituents::FoleyOpitz,
         ..SchemeParams::default()
     };
+    let pnavg = SchemeParams {
+        constituents: Constituents::PnAverage,
+        ..SchemeParams::default()
+    };
     vec![
         ("hybrid", Scheme::Hybrid, SchemeParams::default()),
-        ("coons pnavg", Scheme::Coons, SchemeParams::default()),
+        ("coons pnavg", Scheme::Coons, pnavg),
         ("coons fo", Scheme::Coons, fo),
     ]
 }

@@ -21,12 +21,16 @@ fn variants() -> Vec<(String, Scheme, SchemeParams, f64)> {
         ..SchemeParams::default()
     };
     let d = SchemeParams::default();
+    let pnavg = SchemeParams {
+        constituents: Constituents::PnAverage,
+        ..d
+    };
     vec![
         ("pn".into(), Scheme::Pn, d, 0.0),
         ("g2 h=0.212".into(), Scheme::G2, d, 0.212),
         ("g2 h=0.354".into(), Scheme::G2, d, H_MAX),
         ("hybrid".into(), Scheme::Hybrid, d, 0.2),
-        ("coons pnavg".into(), Scheme::Coons, d, 0.2),
+        ("coons pnavg".into(), Scheme::Coons, pnavg, 0.2),
         ("coons fo".into(), Scheme::Coons, fo, 0.2),
     ]
 }

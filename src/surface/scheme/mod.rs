@@ -102,7 +102,7 @@ pub struct SchemeParams {
     /// Coons: choose λ per triangle by minimising the thin-plate energy of seed 002 Eq. 5
     /// instead of using `lambda`. Default value: `false`.
     pub fair: bool,
-    /// Coons: the edge surfaces blended. Default value: [`Constituents::PnAverage`].
+    /// Coons: the edge surfaces blended. Default value: [`Constituents::FoleyOpitz`].
     pub constituents: Constituents,
 }
 
