@@ -28,15 +28,19 @@
 //! `g2.rs` ([`G2Surface`], [`PnSurface`]: nets per triangle, combination, normals).
 
 pub mod blend;
+pub mod coons;
 mod g2;
+pub mod hybrid;
 pub mod pattern;
 pub mod pn;
 pub mod profile;
+pub mod scheme;
 
 use glam::DVec3;
 
 pub use g2::{G2Surface, PnSurface};
 pub use profile::Profile;
+pub use scheme::{build_surface, Scheme, SchemeParams};
 
 /// Largest blend width: at `h = √2/4` the two arcs of `r(s)` fuse into one and the three regions
 /// of a triangle just touch (notes item 4). `h` is a length in the paper's reference triangle
