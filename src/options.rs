@@ -5,7 +5,9 @@
 //! module deliberately knows nothing of the command line: the binary turns its arguments into an
 //! [`Options`].
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
+
+use crate::surface::SchemeParams;
 
 /// Default tessellation level: every input edge is split into this many segments.
 pub const DEFAULT_LEVEL: u32 = 4;
@@ -34,43 +36,16 @@ pub const DEFAULT_KEEP_HARD_EDGES: bool = false;
 pub const DEFAULT_OPTIMIZE: bool = true;
 /// Default: no overdraw ordering (it costs time and helps only some materials).
 pub const DEFAULT_OVERDRAW: bool = false;
+/// Default Coons shape parameter λ (seed 002), in [0.05, 0.95].
+pub const DEFAULT_COONS_LAMBDA: f64 = SchemeParams::DEFAULT_LAMBDA;
+/// Default: Coons uses the fixed λ rather than thin-plate fairing per triangle.
+pub const DEFAULT_COONS_FAIR: bool = false;
 /// Default: write float attributes (no KHR_mesh_quantization).
 pub const DEFAULT_QUANTIZE: bool = false;
 /// Default: write uncompressed buffers (no EXT_meshopt_compression).
 pub const DEFAULT_COMPRESS: bool = false;
 
-impl From<Profile> for crate::surface::Profile {
-    fn from(p: Profile) -> Self {
-        match p {
-            Profile::Paper => crate::surface::Profile::Paper,
-            Profile::C2 => crate::surface::Profile::C2,
-        }
-    }
-}
-
-/// The radial profile r(s) of the blending region.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Profile {
-    /// The paper's line–arc–plateau profile (C¹ where its pieces meet).
-    Paper,
-    /// A C² profile that removes the paper's G¹ seams inside the blending region.
-    C2,
-}
-
-/// Which smooth surface replaces each triangle.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Scheme {
-    /// G²-blended PN triangles.
-    G2,
-    /// Plain PN triangles.
-    Pn,
-    /// G² where the mesh allows, PN elsewhere.
-    Hybrid,
-    /// Coons-patch blending.
-    Coons,
-}
+pub use crate::surface::{Profile, Scheme};
 
 /// Every setting, resolved. Defaults are the `DEFAULT_*` constants of this module.
 #[derive(Debug, Clone, PartialEq)]
@@ -92,6 +67,10 @@ pub struct Options {
     pub allow_outside_uris: bool,
     /// Allow overwriting an input. Default: [`DEFAULT_FORCE`].
     pub force: bool,
+    /// Coons shape parameter λ. Default: [`DEFAULT_COONS_LAMBDA`]; range 0.05..=0.95.
+    pub coons_lambda: f64,
+    /// Coons: choose λ per triangle by thin-plate fairing. Default: [`DEFAULT_COONS_FAIR`].
+    pub coons_fair: bool,
     /// Give hard edges of the input h = 0. Default: [`DEFAULT_KEEP_HARD_EDGES`].
     pub keep_hard_edges: bool,
     /// Vertex cache and fetch ordering. Default: [`DEFAULT_OPTIMIZE`].
@@ -117,6 +96,8 @@ impl Default for Options {
             max_output_triangles: DEFAULT_MAX_OUTPUT_TRIANGLES,
             allow_outside_uris: DEFAULT_ALLOW_OUTSIDE_URIS,
             force: DEFAULT_FORCE,
+            coons_lambda: DEFAULT_COONS_LAMBDA,
+            coons_fair: DEFAULT_COONS_FAIR,
             keep_hard_edges: DEFAULT_KEEP_HARD_EDGES,
             optimize: DEFAULT_OPTIMIZE,
             overdraw: DEFAULT_OVERDRAW,
@@ -129,7 +110,7 @@ impl Default for Options {
 
 /// A configuration file: every key optional; unknown keys are an error (a typo must not be
 /// silently ignored).
-#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ConfigFile {
     pub level: Option<u32>,
@@ -140,6 +121,8 @@ pub struct ConfigFile {
     pub max_output_triangles: Option<u64>,
     pub allow_outside_uris: Option<bool>,
     pub force: Option<bool>,
+    pub coons_lambda: Option<f64>,
+    pub coons_fair: Option<bool>,
     pub keep_hard_edges: Option<bool>,
     pub optimize: Option<bool>,
     pub overdraw: Option<bool>,
@@ -185,6 +168,8 @@ impl Options {
             max_output_triangles,
             allow_outside_uris,
             force,
+            coons_lambda,
+            coons_fair,
             keep_hard_edges,
             optimize,
             overdraw,
@@ -217,10 +202,26 @@ impl Options {
                 format!("is {} (expected 0 to 180 degrees)", self.crease_angle),
             );
         }
+        if !(0.05..=0.95).contains(&self.coons_lambda) {
+            return err(
+                "coons_lambda",
+                format!("is {} (expected 0.05 to 0.95)", self.coons_lambda),
+            );
+        }
         if self.max_output_triangles == 0 {
             return err("max_output_triangles", "is 0 (expected at least 1)".into());
         }
         Ok(())
+    }
+
+    /// The surface parameters these options imply.
+    pub fn scheme_params(&self) -> SchemeParams {
+        SchemeParams {
+            profile: self.profile,
+            lambda: self.coons_lambda,
+            fair: self.coons_fair,
+            ..SchemeParams::default()
+        }
     }
 
     /// The reader settings these options imply.

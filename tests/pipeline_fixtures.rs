@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use g2tess::gltf_io::{self, Document, ReadOptions};
-use g2tess::options::Options;
+use g2tess::options::{Options, Scheme};
 use g2tess::pipeline::process_file;
 use serde_json::Value;
 
@@ -163,6 +163,48 @@ fn every_valid_asset_smooths_at_level_4_and_keeps_everything() {
                 input.display(),
                 a.codes
             );
+        }
+    }
+}
+
+#[test]
+fn every_valid_asset_smooths_with_every_other_scheme() {
+    let Some(corpus) = corpus::fixtures_real() else {
+        return;
+    };
+    let out_dir = corpus::temp_dir();
+    let mut pairs: Vec<(PathBuf, PathBuf)> = Vec::new();
+    for scheme in [Scheme::Pn, Scheme::Hybrid, Scheme::Coons] {
+        let mut opts = options(2);
+        opts.scheme = scheme;
+        for (n, input) in corpus::gltf_files(&corpus.join("valid")).iter().enumerate() {
+            if is_draco(input) {
+                continue;
+            }
+            let output = out_dir.path().join(format!("{scheme}-{n:03}.glb"));
+            let report = process_file(input, &output, &opts)
+                .unwrap_or_else(|e| panic!("{scheme}: {}: {e}", input.display()));
+            assert_eq!(report.triangles_out, report.triangles_in * 4);
+            pairs.push((input.clone(), output));
+        }
+    }
+    let inputs: Vec<&Path> = pairs.iter().map(|(i, _)| i.as_path()).collect();
+    let outputs: Vec<&Path> = pairs.iter().map(|(_, o)| o.as_path()).collect();
+    let (Some(before), Some(after)) = (corpus::validate(&inputs), corpus::validate(&outputs))
+    else {
+        return;
+    };
+    let by_name = |map: &std::collections::BTreeMap<PathBuf, corpus::Verdict>, p: &Path| {
+        let p = std::fs::canonicalize(p).unwrap();
+        map.iter()
+            .find(|(k, _)| std::fs::canonicalize(k).unwrap() == p)
+            .map(|(_, v)| v.clone())
+            .unwrap()
+    };
+    for (input, output) in &pairs {
+        if by_name(&before, input).errors == 0 {
+            let v = by_name(&after, output);
+            assert_eq!(v.errors, 0, "{}: {:?}", output.display(), v.codes);
         }
     }
 }

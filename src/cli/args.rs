@@ -48,6 +48,14 @@ pub struct Args {
     #[arg(long, value_enum, help_heading = "Surface")]
     pub scheme: Option<SchemeArg>,
 
+    /// Coons shape parameter λ of seed 002, 0.05 to 0.95 [default: 0.5]
+    #[arg(long, value_name = "L", help_heading = "Surface")]
+    pub coons_lambda: Option<f64>,
+
+    /// Coons: choose λ per triangle by thin-plate fairing instead of --coons-lambda
+    #[arg(long, help_heading = "Surface")]
+    pub coons_fair: bool,
+
     /// Give hard edges of the input (split normals) h = 0
     #[arg(long, help_heading = "Surface")]
     pub keep_hard_edges: bool,
@@ -111,9 +119,9 @@ pub enum SchemeArg {
     G2,
     /// Plain PN triangles
     Pn,
-    /// G² where possible, PN elsewhere
+    /// Mann–Davidchuk parametric hybrid patches (G¹)
     Hybrid,
-    /// Coons-patch blending
+    /// Szilvási-Nagy–Szabó C¹ Coons-type blending (G¹)
     Coons,
 }
 
@@ -148,6 +156,8 @@ impl Args {
             max_output_triangles: self.max_triangles,
             allow_outside_uris: self.allow_outside_uris.then_some(true),
             force: self.force.then_some(true),
+            coons_lambda: self.coons_lambda,
+            coons_fair: self.coons_fair.then_some(true),
             keep_hard_edges: self.keep_hard_edges.then_some(true),
             optimize: self.no_optimize.then_some(false),
             overdraw: self.overdraw.then_some(true),

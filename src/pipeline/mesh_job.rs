@@ -18,9 +18,9 @@ use super::primitive_out::{self, Prepared};
 use super::report::{EdgeFigures, MeshReport, PrimitiveReport};
 use crate::gltf_io::{self, PrimitiveData, Values};
 use crate::mesh::TriMesh;
-use crate::options::{Options, Scheme};
+use crate::options::Options;
 use crate::sharpness::{AssetSharpness, MeshContext, PrimitiveContext};
-use crate::surface::{G2Surface, PnSurface, Surface};
+use crate::surface::{scheme, Surface};
 use crate::tessellate::tessellate;
 use crate::topology::Topology;
 use crate::{normals, optimize};
@@ -108,10 +108,10 @@ pub fn smooth_mesh(
         .extend(params.warnings.iter().map(|w| w.to_string()));
     report.times.sharpness = lap(&clock, report.times.topology);
 
-    let surface = build_surface(options, &mesh, &topo, &params.h);
+    let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &params.h);
     report.warnings.extend(
-        topo.warnings()
-            .iter()
+        surface_warnings
+            .into_iter()
             .map(|w| format!("mesh {}: {w}", input.mesh)),
     );
     report.edges = EdgeFigures::measure(surface.as_ref(), &topo, &params.h);
@@ -159,17 +159,16 @@ fn lap(clock: &Instant, before: f64) -> f64 {
     clock.elapsed().as_secs_f64() - before
 }
 
-/// The surface for `scheme`. Hybrid and Coons construct their own; PN is G² with every h = 0.
+/// The surface the options ask for, with the warnings its construction gave.
 pub(super) fn build_surface(
     options: &Options,
     mesh: &TriMesh,
     topo: &Topology,
     h: &[f64],
-) -> Box<dyn Surface> {
-    match options.scheme {
-        Scheme::Pn => Box::new(PnSurface::new(mesh, topo)),
-        _ => Box::new(G2Surface::new(mesh, topo, h, options.profile.into())),
-    }
+) -> (Box<dyn Surface>, Vec<String>) {
+    let params = options.scheme_params();
+    let (surface, warnings) = scheme::build_surface(options.scheme, mesh, topo, h, &params);
+    (surface, warnings.iter().map(ToString::to_string).collect())
 }
 
 /// Checks a primitive's positions and normals, generating normals where there are none.

@@ -50,7 +50,7 @@ pub fn targets(
     let mut out: Vec<Vec<TargetSurface>> = vec![Vec::with_capacity(count); prepared.len()];
     for t in 0..count {
         let moved = displaced(mesh, prepared, t);
-        let surface = super::mesh_job::build_surface(options, &moved, topo, h);
+        let (surface, _) = super::mesh_job::build_surface(options, &moved, topo, h);
         let dense = tessellate(&moved, topo, h, surface.as_ref(), level, groups);
         for (k, d) in dense.into_iter().enumerate() {
             let (positions, normals) = match &remaps[k] {

@@ -36,7 +36,10 @@
 //! [`Profile::C2`] is therefore the default.
 
 /// Which `r(s)` shapes the blending regions.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Deserialize, serde::Serialize,
+)]
+#[serde(rename_all = "lowercase")]
 pub enum Profile {
     /// The paper's line–arc–plateau profile (C¹ at its switch points).
     Paper,

@@ -30,7 +30,10 @@ use super::hybrid::HybridSurface;
 use super::{G2Surface, PnSurface, Profile, Surface};
 
 /// A surface construction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Deserialize, serde::Serialize,
+)]
+#[serde(rename_all = "lowercase")]
 pub enum Scheme {
     /// PN triangles blended across edges for G² (Lee–Hwang–Yoon, seed 000).
     #[default]
