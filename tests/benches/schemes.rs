@@ -5,7 +5,7 @@
 //! The mesh is the 320-triangle bumpy sphere of the tests, evaluated point by point on the
 //! level-16 lattice of every triangle (153 points per triangle, 48 960 per pass).
 
-#[path = "../tests/support/mod.rs"]
+#[path = "../support/mod.rs"]
 mod support;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
