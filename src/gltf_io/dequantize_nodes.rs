@@ -1,4 +1,4 @@
-//! Puts the dequantization of integer positions (see [`super::quantize`]) into the node graph:
+//! Puts the dequantization of integer positions (see [`mod@super::quantize`]) into the node graph:
 //! every node that uses a quantized mesh hands the mesh to a new child node whose translation and
 //! uniform scale map the integers back to the mesh's space.
 //!

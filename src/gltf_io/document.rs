@@ -62,7 +62,7 @@ pub struct Document {
     pub is_glb: bool,
     /// Whether the reader may follow `uri`s out of `base_dir` (kept for embedding images).
     pub(crate) allow_outside_uris: bool,
-    /// Meshes whose positions [`super::quantize`] stored as integers, with the transform that
+    /// Meshes whose positions [`mod@super::quantize`] stored as integers, with the transform that
     /// maps them back; the writer puts it on a child node of every node using the mesh.
     pub(crate) dequantize: std::collections::BTreeMap<usize, super::quantize::Dequantize>,
     /// Buffer views whose bytes are the decoded form of a meshopt filter, with the filter's

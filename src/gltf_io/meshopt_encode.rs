@@ -1,12 +1,12 @@
 //! EXT_meshopt_compression on write: every buffer view that holds only accessor data is
 //! compressed (attribute codec, version 0 as the extension requires; triangle codec for triangle
 //! list indices; index-sequence codec for other indices; the OCTAHEDRAL filter where
-//! [`super::quantize`] left octahedral normals), its compressed bytes go to buffer 0, and the view
+//! [`mod@super::quantize`] left octahedral normals), its compressed bytes go to buffer 0, and the view
 //! itself moves to a fallback buffer that holds the uncompressed layout.
 //!
 //! It deliberately compresses nothing it cannot reproduce exactly: views of images, of sparse
 //! accessors and of data only extensions refer to stay as they are. It does not quantize (that is
-//! [`super::quantize`]) and it writes no files (the writer does).
+//! [`mod@super::quantize`]) and it writes no files (the writer does).
 
 use std::collections::{BTreeMap, BTreeSet};
 

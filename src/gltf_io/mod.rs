@@ -8,7 +8,7 @@
 //! - [`glb`]: the GLB container
 //! - [`uri`]: `data:` and file `uri`s, bounded to the asset's folder
 //! - [`meshopt_decode`]: EXT_/KHR_meshopt_compression buffer views
-//! - [`quantize`]: KHR_mesh_quantization of every mesh ([`Quantization`])
+//! - [`mod@quantize`]: KHR_mesh_quantization of every mesh ([`Quantization`])
 //! - [`dequantize_nodes`]: the node transforms that undo position quantization, on write
 //! - [`meshopt_encode`]: EXT_meshopt_compression of the written views ([`Compression`])
 //! - [`accessor`]: every accessor layout, sparse and zero-filled ones
