@@ -37,8 +37,11 @@ pub(crate) fn apply(root: &mut Map<String, Value>, meshes: &BTreeMap<usize, Dequ
             continue;
         };
         let mut child = Map::new();
-        child.insert("mesh".into(), obj.remove("mesh").expect("checked above"));
-        if let Some(w) = obj.remove("weights") {
+        child.insert(
+            "mesh".into(),
+            obj.shift_remove("mesh").expect("checked above"),
+        );
+        if let Some(w) = obj.shift_remove("weights") {
             child.insert("weights".into(), w);
         }
         child.insert("translation".into(), json!(d.offset.map(shortest)));

@@ -330,7 +330,6 @@ fn assemble(
         None => None,
     };
     set_array(root, "bufferViews", views);
-    set_array(root, "buffers", vec![]);
     fix_extension_lists(root);
     let mut buffers = if bin.is_empty() && fallback.is_none() {
         vec![]
