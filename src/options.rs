@@ -44,6 +44,9 @@ pub const DEFAULT_COONS_FAIR: bool = false;
 pub const DEFAULT_QUANTIZE: bool = false;
 /// Default: write uncompressed buffers (no EXT_meshopt_compression).
 pub const DEFAULT_COMPRESS: bool = false;
+/// Default: a compressed output carries no uncompressed copy (its fallback buffer is a
+/// placeholder, and EXT_meshopt_compression is required to load it).
+pub const DEFAULT_COMPRESS_FALLBACK: bool = false;
 
 pub use crate::surface::{Profile, Scheme};
 
@@ -83,6 +86,9 @@ pub struct Options {
     pub quantize: bool,
     /// Compress output buffers. Default: [`DEFAULT_COMPRESS`].
     pub compress: bool,
+    /// With `compress`, also write the uncompressed data to `<output>.fallback.bin`.
+    /// Default: [`DEFAULT_COMPRESS_FALLBACK`].
+    pub compress_fallback: bool,
 }
 
 impl Default for Options {
@@ -104,6 +110,7 @@ impl Default for Options {
             sidecar: None,
             quantize: DEFAULT_QUANTIZE,
             compress: DEFAULT_COMPRESS,
+            compress_fallback: DEFAULT_COMPRESS_FALLBACK,
         }
     }
 }
@@ -128,6 +135,7 @@ pub struct ConfigFile {
     pub overdraw: Option<bool>,
     pub quantize: Option<bool>,
     pub compress: Option<bool>,
+    pub compress_fallback: Option<bool>,
 }
 
 /// A configuration problem: `<where>: <what> (expected …)`.
@@ -174,7 +182,8 @@ impl Options {
             optimize,
             overdraw,
             quantize,
-            compress
+            compress,
+            compress_fallback
         );
         self
     }
@@ -222,6 +231,19 @@ impl Options {
             fair: self.coons_fair,
             ..SchemeParams::default()
         }
+    }
+
+    /// The quantization these options ask for (octahedral normals when also compressing, since
+    /// only a compressed output can carry the filter).
+    pub fn quantization(&self) -> Option<crate::gltf_io::Quantization> {
+        self.quantize
+            .then(|| crate::gltf_io::Quantization::default().with_octahedral(self.compress))
+    }
+
+    /// The compression these options ask for.
+    pub fn compression(&self) -> Option<crate::gltf_io::Compression> {
+        self.compress
+            .then(|| crate::gltf_io::Compression::new(self.compress_fallback))
     }
 
     /// The reader settings these options imply.

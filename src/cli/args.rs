@@ -84,13 +84,18 @@ pub struct Args {
     #[arg(long, value_name = "N", help_heading = "Output")]
     pub max_triangles: Option<u64>,
 
-    /// Store attributes quantized (KHR_mesh_quantization)
+    /// Store attributes quantized (KHR_mesh_quantization): positions 14 bits, normals and
+    /// tangents 8 bits, UVs in [0, 1] 12 bits; skinned positions and other UVs stay float
     #[arg(long, help_heading = "Output")]
     pub quantize: bool,
 
-    /// Compress buffers (EXT_meshopt_compression)
+    /// Compress buffers (EXT_meshopt_compression; loaders then require it)
     #[arg(long, help_heading = "Output")]
     pub compress: bool,
+
+    /// With --compress, also write the uncompressed data to OUTPUT.fallback.bin
+    #[arg(long, help_heading = "Output", requires = "compress")]
+    pub compress_fallback: bool,
 
     /// Allow overwriting an input file
     #[arg(long, help_heading = "Safety")]
@@ -163,6 +168,7 @@ impl Args {
             overdraw: self.overdraw.then_some(true),
             quantize: self.quantize.then_some(true),
             compress: self.compress.then_some(true),
+            compress_fallback: self.compress_fallback.then_some(true),
         };
         let mut opts = opts.overlay(&flags);
         opts.sidecar = self.sidecar.clone();

@@ -62,6 +62,12 @@ pub struct Document {
     pub is_glb: bool,
     /// Whether the reader may follow `uri`s out of `base_dir` (kept for embedding images).
     pub(crate) allow_outside_uris: bool,
+    /// Meshes whose positions [`mod@super::quantize`] stored as integers, with the transform that
+    /// maps them back; the writer puts it on a child node of every node using the mesh.
+    pub(crate) dequantize: std::collections::BTreeMap<usize, super::quantize::Dequantize>,
+    /// Buffer views whose bytes are the decoded form of a meshopt filter, with the filter's
+    /// encoded bytes, so the compressor does not have to re-derive them (and lose precision).
+    pub(crate) filtered: std::collections::BTreeMap<usize, super::quantize::Filtered>,
 }
 
 /// Reads the asset at `path` (`.gltf` or `.glb`, told apart by content).
@@ -129,6 +135,8 @@ pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> 
         base_dir: base_dir.map(Path::to_path_buf),
         is_glb,
         allow_outside_uris: opts.allow_outside_uris,
+        dequantize: Default::default(),
+        filtered: Default::default(),
     };
     meshopt_decode::decode_views(&mut doc, opts.max_bytes)?;
     validate::data(&doc, opts.max_bytes)?;

@@ -8,6 +8,9 @@
 //! - [`glb`]: the GLB container
 //! - [`uri`]: `data:` and file `uri`s, bounded to the asset's folder
 //! - [`meshopt_decode`]: EXT_/KHR_meshopt_compression buffer views
+//! - [`mod@quantize`]: KHR_mesh_quantization of every mesh ([`Quantization`])
+//! - [`dequantize_nodes`]: the node transforms that undo position quantization, on write
+//! - [`meshopt_encode`]: EXT_meshopt_compression of the written views ([`Compression`])
 //! - [`accessor`]: every accessor layout, sparse and zero-filled ones
 //! - [`validate`]: what the spec calls an error, refused at read time
 //! - [`primitive`]: [`PrimitiveData`] out of and back into a document
@@ -16,17 +19,22 @@
 //! - [`error`]: [`Error`], located by JSON path
 
 pub mod accessor;
+pub mod dequantize_nodes;
 pub mod document;
 pub mod error;
 pub mod glb;
 pub mod json_merge;
 pub mod meshopt_decode;
+pub mod meshopt_encode;
 pub mod primitive;
+pub mod quantize;
 pub mod uri;
 pub mod validate;
 pub mod write;
 
 pub use document::{read, read_bytes, Document, ReadOptions};
 pub use error::{Error, ErrorKind, Result};
+pub use meshopt_encode::Compression;
 pub use primitive::{replace_primitive, Attribute, PrimitiveData, Values};
-pub use write::{write, WriteOptions};
+pub use quantize::{quantize, Quantization};
+pub use write::{fallback_path, write, WriteOptions};

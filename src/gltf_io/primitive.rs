@@ -383,6 +383,7 @@ fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
         count,
         ct,
         vector_type(n),
+        false,
         bounds.then(|| Value::Array(min)),
         bounds.then(|| Value::Array(max)),
     )
@@ -417,17 +418,21 @@ fn push_indices(doc: &mut Document, indices: &[u32], vertices: usize) -> usize {
         indices.len(),
         ct,
         Type::Scalar,
+        false,
         bounds.as_ref().map(|b| b.0.clone()),
         bounds.map(|b| b.1),
     )
 }
 
-fn push_accessor(
+/// Appends an accessor over the whole of `view`; returns its index.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn push_accessor(
     doc: &mut Document,
     view: usize,
     count: usize,
     ct: ComponentType,
     ty: Type,
+    normalized: bool,
     min: Option<Value>,
     max: Option<Value>,
 ) -> usize {
@@ -442,7 +447,7 @@ fn push_accessor(
         min,
         max,
         name: None,
-        normalized: false,
+        normalized,
         sparse: None,
     });
     doc.root.accessors.len() - 1

@@ -14,7 +14,8 @@ use serde_json::{json, Map, Value};
 
 use super::document::Document;
 use super::error::{Error, Result};
-use super::{glb, json_merge, meshopt_decode, uri};
+use super::meshopt_encode::{self, Compression};
+use super::{dequantize_nodes, glb, json_merge, meshopt_decode, uri};
 
 /// How to write.
 #[derive(Debug, Clone, Default)]
@@ -25,6 +26,8 @@ pub struct WriteOptions {
     pub overwrite_input: bool,
     /// The file the document was read from, to refuse overwriting it. Default: none.
     pub input: Option<PathBuf>,
+    /// Compress buffer views with EXT_meshopt_compression. Default: none (uncompressed).
+    pub compression: Option<Compression>,
 }
 
 impl WriteOptions {
@@ -33,8 +36,20 @@ impl WriteOptions {
         Self {
             input,
             overwrite_input,
+            compression: None,
         }
     }
+
+    /// These options with `compression` (none: uncompressed).
+    pub fn with_compression(mut self, compression: Option<Compression>) -> Self {
+        self.compression = compression;
+        self
+    }
+}
+
+/// The file beside `path` that holds the uncompressed fallback of a compressed output.
+pub fn fallback_path(path: &Path) -> PathBuf {
+    path.with_extension("fallback.bin")
 }
 
 /// Writes `doc` to `path` (`.glb`, or `.gltf` + `<stem>.bin`).
@@ -55,10 +70,26 @@ pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
         }
     };
     let bin_path = (!as_glb).then(|| path.with_extension("bin"));
+    let fallback = opts
+        .compression
+        .filter(|c| c.fallback)
+        .map(|_| fallback_path(path));
     refuse_overwriting_input(doc, path, bin_path.as_deref(), opts)?;
+    if let Some(f) = &fallback {
+        refuse_overwriting_input(doc, f, None, opts)?;
+    }
     let out_dir = parent_dir(path);
     let embed_images = !same_dir(doc.base_dir.as_deref(), out_dir);
-    let (json, bin) = assemble(doc, embed_images, bin_path.as_deref())?;
+    let (json, bin, fallback_bytes) = assemble(
+        doc,
+        embed_images,
+        bin_path.as_deref(),
+        opts.compression,
+        fallback.as_deref(),
+    )?;
+    if let (Some(f), Some(bytes)) = (&fallback, &fallback_bytes) {
+        atomic_write(f, bytes)?;
+    }
     if as_glb {
         let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
         atomic_write(path, &glb::assemble(&text, &bin))
@@ -151,12 +182,15 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
-/// Builds the output JSON and its single binary buffer.
+/// Builds the output JSON, its binary buffer, and (compressed, when asked) the uncompressed
+/// fallback buffer's bytes.
 fn assemble(
     doc: &Document,
     embed_images: bool,
     bin_path: Option<&Path>,
-) -> Result<(Value, Vec<u8>)> {
+    compression: Option<Compression>,
+    fallback_path: Option<&Path>,
+) -> Result<(Value, Vec<u8>, Option<Vec<u8>>)> {
     let now = serde_json::to_value(&doc.root).map_err(|e| Error::invalid("json", e))?;
     let mut out = json_merge::merge(&doc.base, &now, &doc.raw);
     let root = out
@@ -165,6 +199,7 @@ fn assemble(
     for ((m, p), prim) in &doc.replaced {
         root["meshes"][*m]["primitives"][*p] = prim.clone();
     }
+    dequantize_nodes::apply(root, &doc.dequantize);
 
     // Which accessors and views survive.
     let mut referenced = BTreeSet::new();
@@ -283,20 +318,67 @@ fn assemble(
         embed_external_images(doc, root, &mut bin, &mut views)?;
     }
     set_array(root, "accessors", accessors);
+    let fallback = match compression {
+        Some(c) => {
+            let filtered = doc
+                .filtered
+                .iter()
+                .filter_map(|(v, f)| Some((view_map.get(*v).copied().flatten()?, f.clone())))
+                .collect();
+            meshopt_encode::compress(root, &mut views, &mut bin, &filtered, c.fallback)?
+        }
+        None => None,
+    };
     set_array(root, "bufferViews", views);
-    let buffers = if bin.is_empty() {
+    fix_extension_lists(root);
+    let mut buffers = if bin.is_empty() && fallback.is_none() {
         vec![]
     } else {
         align4(&mut bin);
         let mut b = json!({ "byteLength": bin.len() });
-        if let Some(name) = bin_path.and_then(Path::file_name).and_then(|n| n.to_str()) {
-            b["uri"] = json!(percent_encoding::utf8_percent_encode(name, URI_ESCAPES).to_string());
+        if let Some(u) = file_uri(bin_path) {
+            b["uri"] = json!(u);
         }
         vec![b]
     };
+    if let Some(f) = &fallback {
+        let mut b = json!({
+            "byteLength": f.byte_length,
+            "extensions": { meshopt_encode::EXTENSION: { "fallback": true } },
+        });
+        if let Some(u) = file_uri(fallback_path).filter(|_| f.bytes.is_some()) {
+            b["uri"] = json!(u);
+        }
+        buffers.push(b);
+    }
     set_array(root, "buffers", buffers);
-    fix_extension_lists(root);
-    Ok((out, bin))
+    if let Some(f) = &fallback {
+        add_extension(root, meshopt_encode::EXTENSION, f.bytes.is_none());
+    }
+    Ok((out, bin, fallback.and_then(|f| f.bytes)))
+}
+
+/// The relative `uri` of a file written beside the output.
+fn file_uri(path: Option<&Path>) -> Option<String> {
+    let name = path.and_then(Path::file_name).and_then(|n| n.to_str())?;
+    Some(percent_encoding::utf8_percent_encode(name, URI_ESCAPES).to_string())
+}
+
+/// Lists `name` in `extensionsUsed`, and in `extensionsRequired` when `required`.
+fn add_extension(root: &mut Map<String, Value>, name: &str, required: bool) {
+    let keys: &[&str] = if required {
+        &["extensionsUsed", "extensionsRequired"]
+    } else {
+        &["extensionsUsed"]
+    };
+    for key in keys {
+        let list = root.entry(*key).or_insert_with(|| json!([]));
+        if let Some(list) = list.as_array_mut() {
+            if !list.iter().any(|e| e == name) {
+                list.push(json!(name));
+            }
+        }
+    }
 }
 
 /// Characters escaped in a written file name `uri` (RFC 3986 reserved and unsafe ones).
@@ -492,9 +574,13 @@ fn mime_of(path: &Path, bytes: &[u8]) -> Option<String> {
 }
 
 /// Keeps `extensionsUsed`/`extensionsRequired` true to what is written: meshopt compression is
-/// decoded on read, and KHR_mesh_quantization is only needed while quantized attributes remain.
+/// decoded on read (the compressor adds it back), and KHR_mesh_quantization is listed exactly
+/// when quantized attributes are written.
 fn fix_extension_lists(root: &mut Map<String, Value>) {
     let quantized = uses_quantized_attributes(root);
+    if quantized {
+        add_extension(root, "KHR_mesh_quantization", true);
+    }
     for key in ["extensionsUsed", "extensionsRequired"] {
         if let Some(list) = root.get_mut(key).and_then(Value::as_array_mut) {
             list.retain(|e| {
@@ -504,13 +590,6 @@ fn fix_extension_lists(root: &mut Map<String, Value>) {
             });
             if list.is_empty() {
                 root.remove(key);
-            }
-        }
-    }
-    for buffer in arr(root, "buffers") {
-        if let Some(ext) = buffer.get_mut("extensions").and_then(Value::as_object_mut) {
-            for n in meshopt_decode::EXTENSIONS {
-                ext.remove(n);
             }
         }
     }

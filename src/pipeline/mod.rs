@@ -36,7 +36,11 @@ pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<Fi
     let read_s = started.elapsed().as_secs_f64();
     let mut report = process_document(&mut doc, input, options)?;
     let write_start = Instant::now();
-    let write = WriteOptions::new(Some(input.to_path_buf()), options.force);
+    if let Some(q) = options.quantization() {
+        gltf_io::quantize(&mut doc, &q).map_err(located)?;
+    }
+    let write = WriteOptions::new(Some(input.to_path_buf()), options.force)
+        .with_compression(options.compression());
     gltf_io::write(&doc, output, &write).map_err(|e| Error::gltf(output, e))?;
     report.times.read = read_s;
     report.times.write = write_start.elapsed().as_secs_f64();
