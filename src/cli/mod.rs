@@ -34,6 +34,9 @@ pub fn run() -> i32 {
             return EXIT_USAGE;
         }
     };
+    if let Some(mesh) = &args.explain_h {
+        return explain_h(&args.inputs, &options, mesh);
+    }
     let outputs = match output_paths(&args.inputs, args.output.as_deref()) {
         Ok(o) => o,
         Err(msg) => {
@@ -52,6 +55,26 @@ pub fn run() -> i32 {
                 r.triangles_in,
                 r.triangles_out
             ),
+            Err(e) => {
+                eprintln!("g2tess: error: {e}");
+                status = EXIT_SOME_FAILED;
+            }
+        }
+    }
+    status
+}
+
+/// `--explain-h MESH`: prints, per input, which source set each edge's h; writes nothing.
+fn explain_h(inputs: &[PathBuf], options: &g2tess::options::Options, mesh: &str) -> i32 {
+    let mut status = EXIT_OK;
+    for input in inputs {
+        match g2tess::pipeline::explain_h(input, options, mesh) {
+            Ok(lines) => {
+                println!("{}: mesh {mesh}", input.display());
+                for line in lines {
+                    println!("  {line}");
+                }
+            }
             Err(e) => {
                 eprintln!("g2tess: error: {e}");
                 status = EXIT_SOME_FAILED;

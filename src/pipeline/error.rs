@@ -20,6 +20,14 @@ pub enum Error {
     /// A per-edge h source (extras, sidecar, options) has a mistake; it names its own file.
     #[error(transparent)]
     Sharpness(#[from] SharpnessError),
+    /// The request does not fit the asset (a mesh named on the command line that it lacks).
+    #[error("{}: {what}", file.display())]
+    Request {
+        /// The asset.
+        file: PathBuf,
+        /// What was asked and what the asset has.
+        what: String,
+    },
     /// The work would exceed a resource bound.
     #[error("{}: {what}", file.display())]
     Limit {

@@ -19,7 +19,7 @@ use super::report::{EdgeFigures, MeshReport, PrimitiveReport};
 use crate::gltf_io::{self, PrimitiveData, Values};
 use crate::mesh::TriMesh;
 use crate::options::Options;
-use crate::sharpness::{AssetSharpness, MeshContext, PrimitiveContext};
+use crate::sharpness::{AssetSharpness, EdgeParams, MeshContext, PrimitiveContext};
 use crate::surface::{scheme, Surface};
 use crate::tessellate::tessellate;
 use crate::topology::Topology;
@@ -61,30 +61,38 @@ pub struct MeshOutput {
 }
 
 /// Smooths one mesh at `level`.
-pub fn smooth_mesh(
+/// A mesh welded and with its h resolved: what every later stage starts from.
+pub(super) struct Resolved {
+    /// Each primitive, checked (and with generated normals where it had none).
+    pub prepared: Vec<Prepared>,
+    /// All primitives joined.
+    pub mesh: TriMesh,
+    /// Each primitive's triangles in `mesh`.
+    pub groups: Vec<Range<usize>>,
+    /// Adjacency of `mesh`.
+    pub topo: Topology,
+    /// One h per welded edge, with where each came from.
+    pub params: EdgeParams,
+}
+
+/// Checks and joins the primitives of `input`, welds them and resolves per-edge h; warnings
+/// go to `warnings`.
+pub(super) fn resolve(
     input: &MeshInput,
     sharpness: &AssetSharpness,
-    level: u32,
     options: &Options,
     asset: &Path,
-) -> Result<MeshOutput, Error> {
-    let mut report = MeshReport {
-        mesh: input.mesh,
-        name: input.name.clone(),
-        ..MeshReport::default()
-    };
-    let clock = Instant::now();
+    warnings: &mut Vec<String>,
+) -> Result<Resolved, Error> {
     let mut prepared: Vec<Prepared> = input
         .primitives
         .iter()
-        .map(|p| prepare(input.mesh, p, options.crease_angle, &mut report.warnings))
+        .map(|p| prepare(input.mesh, p, options.crease_angle, warnings))
         .collect::<Result<_, _>>()
         .map_err(|e| Error::gltf(asset, e))?;
     assign_offsets(&mut prepared);
     let (mesh, groups) = join(&prepared);
     let topo = Topology::build(&mesh);
-    report.times.topology = lap(&clock, 0.0);
-
     let contexts: Vec<PrimitiveContext> = input
         .primitives
         .iter()
@@ -103,10 +111,38 @@ pub fn smooth_mesh(
         primitives: &contexts,
     };
     let params = sharpness.resolve_mesh(&ctx, &mesh, &topo)?;
-    report
-        .warnings
-        .extend(params.warnings.iter().map(|w| w.to_string()));
-    report.times.sharpness = lap(&clock, report.times.topology);
+    warnings.extend(params.warnings.iter().map(|w| w.to_string()));
+    Ok(Resolved {
+        prepared,
+        mesh,
+        groups,
+        topo,
+        params,
+    })
+}
+
+/// Smooths one mesh at `level`.
+pub fn smooth_mesh(
+    input: &MeshInput,
+    sharpness: &AssetSharpness,
+    level: u32,
+    options: &Options,
+    asset: &Path,
+) -> Result<MeshOutput, Error> {
+    let mut report = MeshReport {
+        mesh: input.mesh,
+        name: input.name.clone(),
+        ..MeshReport::default()
+    };
+    let clock = Instant::now();
+    let Resolved {
+        prepared,
+        mesh,
+        groups,
+        topo,
+        params,
+    } = resolve(input, sharpness, options, asset, &mut report.warnings)?;
+    report.times.sharpness = lap(&clock, 0.0);
 
     let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &params.h);
     report.warnings.extend(
@@ -115,8 +151,7 @@ pub fn smooth_mesh(
             .map(|w| format!("mesh {}: {w}", input.mesh)),
     );
     report.edges = EdgeFigures::measure(surface.as_ref(), &topo, &params.h);
-    let t_surface = lap(&clock, report.times.topology + report.times.sharpness);
-    report.times.surface = t_surface;
+    report.times.surface = lap(&clock, report.times.sharpness);
 
     let tess_start = Instant::now();
     let mut dense = tessellate(&mesh, &topo, &params.h, surface.as_ref(), level, &groups);

@@ -22,7 +22,7 @@ use serde_json::Value;
 
 use crate::gltf_io::{self, Document, PrimitiveData, WriteOptions};
 use crate::options::Options;
-use crate::sharpness::{AssetSharpness, Defaults, Sidecar};
+use crate::sharpness::{explain_rows, AssetSharpness, Defaults, Sidecar};
 
 pub use error::Error;
 pub use mesh_job::{MeshInput, MeshOutput};
@@ -61,42 +61,12 @@ pub fn process_document(
     asset: &Path,
     options: &Options,
 ) -> Result<FileReport, Error> {
-    let sidecar = Sidecar::discover(asset, options.sidecar.as_deref())?;
-    let mesh_names: Vec<Option<&str>> = doc.root.meshes.iter().map(|m| m.name.as_deref()).collect();
-    let defaults = Defaults {
-        h: options.h,
-        crease_angle: options.crease_angle,
-        keep_hard_edges: options.keep_hard_edges,
-    };
-    let sharpness = AssetSharpness::new(asset, sidecar, &mesh_names, defaults)?;
+    let sharpness = asset_sharpness(doc, asset, options)?;
     let level = sharpness.level().unwrap_or(options.level);
 
     // Decode every triangle primitive first (the document is only read here).
     let decode_start = Instant::now();
-    let mut inputs: Vec<MeshInput> = Vec::new();
-    for (mesh, prim) in doc.triangle_primitives() {
-        let data = doc
-            .read_primitive(mesh, prim)
-            .map_err(|e| Error::gltf(asset, e))?;
-        if inputs.last().map(|m| m.mesh) != Some(mesh) {
-            inputs.push(MeshInput {
-                mesh,
-                name: doc.root.meshes[mesh].name.clone(),
-                extras: raw_extras(doc, &["meshes"], mesh),
-                primitives: Vec::new(),
-            });
-        }
-        let current = inputs.last_mut().expect("pushed above");
-        current.primitives.push(mesh_job::PrimitiveInput {
-            index: prim,
-            extras: doc
-                .raw
-                .pointer(&format!("/meshes/{mesh}/primitives/{prim}/extras"))
-                .cloned(),
-            needs_tangents: needs_tangents(doc, mesh, prim, &data),
-            data,
-        });
-    }
+    let inputs = mesh_inputs(doc, asset)?;
     let decode_s = decode_start.elapsed().as_secs_f64();
 
     check_output_size(&inputs, level, options, asset)?;
@@ -121,6 +91,86 @@ pub fn process_document(
         report.add_mesh(out.report);
     }
     Ok(report)
+}
+
+/// Every mesh with triangle primitives, decoded, in file order.
+fn mesh_inputs(doc: &Document, asset: &Path) -> Result<Vec<MeshInput>, Error> {
+    let mut inputs: Vec<MeshInput> = Vec::new();
+    for (mesh, prim) in doc.triangle_primitives() {
+        let data = doc
+            .read_primitive(mesh, prim)
+            .map_err(|e| Error::gltf(asset, e))?;
+        if inputs.last().map(|m| m.mesh) != Some(mesh) {
+            inputs.push(MeshInput {
+                mesh,
+                name: doc.root.meshes[mesh].name.clone(),
+                extras: raw_extras(doc, &["meshes"], mesh),
+                primitives: Vec::new(),
+            });
+        }
+        let current = inputs.last_mut().expect("pushed above");
+        current.primitives.push(mesh_job::PrimitiveInput {
+            index: prim,
+            extras: doc
+                .raw
+                .pointer(&format!("/meshes/{mesh}/primitives/{prim}/extras"))
+                .cloned(),
+            needs_tangents: needs_tangents(doc, mesh, prim, &data),
+            data,
+        });
+    }
+    Ok(inputs)
+}
+
+/// The sharpness sources of an asset: its sidecar, its mesh names, the options' defaults.
+fn asset_sharpness(
+    doc: &Document,
+    asset: &Path,
+    options: &Options,
+) -> Result<AssetSharpness, Error> {
+    let sidecar = Sidecar::discover(asset, options.sidecar.as_deref())?;
+    let mesh_names: Vec<Option<&str>> = doc.root.meshes.iter().map(|m| m.name.as_deref()).collect();
+    let defaults = Defaults {
+        h: options.h,
+        crease_angle: options.crease_angle,
+        keep_hard_edges: options.keep_hard_edges,
+    };
+    Ok(AssetSharpness::new(asset, sidecar, &mesh_names, defaults)?)
+}
+
+/// For `--explain-h`: one line per welded edge of mesh `which` (its name or index) saying
+/// which source set its h, so a user can see why an edge is sharp.
+pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<String>, Error> {
+    let doc = gltf_io::read(input, &options.read_options()).map_err(|e| Error::gltf(input, e))?;
+    let sharpness = asset_sharpness(&doc, input, options)?;
+    let inputs = mesh_inputs(&doc, input)?;
+    let found = inputs.iter().find(|m| {
+        m.name.as_deref() == Some(which) || which.parse::<usize>().is_ok_and(|i| i == m.mesh)
+    });
+    let Some(mesh) = found else {
+        let known: Vec<String> = inputs
+            .iter()
+            .map(|m| match &m.name {
+                Some(n) => format!("{} \"{n}\"", m.mesh),
+                None => m.mesh.to_string(),
+            })
+            .collect();
+        return Err(Error::Request {
+            file: input.to_path_buf(),
+            what: format!(
+                "--explain-h {which}: no mesh with triangles has that name or index (expected one of: {})",
+                known.join(", ")
+            ),
+        });
+    };
+    let mut warnings = Vec::new();
+    let resolved = mesh_job::resolve(mesh, &sharpness, options, input, &mut warnings)?;
+    let rows = explain_rows(&resolved.params, &resolved.topo);
+    Ok(rows
+        .iter()
+        .map(ToString::to_string)
+        .chain(warnings)
+        .collect())
 }
 
 /// The `extras` of `collection[index]` as plain JSON, if any.

@@ -20,9 +20,7 @@ pub struct StageTimes {
     pub read: f64,
     /// Decoding the triangle primitives.
     pub decode: f64,
-    /// Welding and adjacency.
-    pub topology: f64,
-    /// Resolving per-edge h.
+    /// Checking the primitives, welding them and resolving per-edge h.
     pub sharpness: f64,
     /// Building the surface and measuring its continuity.
     pub surface: f64,
@@ -40,7 +38,6 @@ pub struct StageTimes {
 
 impl StageTimes {
     fn add(&mut self, other: &StageTimes) {
-        self.topology += other.topology;
         self.sharpness += other.sharpness;
         self.surface += other.surface;
         self.tessellate += other.tessellate;
