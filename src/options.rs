@@ -25,8 +25,8 @@ pub const DEFAULT_SCHEME: Scheme = Scheme::G2;
 pub const DEFAULT_MAX_OUTPUT_TRIANGLES: u64 = 50_000_000;
 /// Default: `uri`s may not leave the asset's folder.
 pub const DEFAULT_ALLOW_OUTSIDE_URIS: bool = false;
-/// Default: never overwrite an input file.
-pub const DEFAULT_FORCE: bool = false;
+/// Default: never overwrite an input file (or a buffer or image file it refers to).
+pub const DEFAULT_OVERWRITE_INPUT: bool = false;
 /// Default: hard edges of the input (split normals) are not forced sharp: the surface closes
 /// them smoothly unless the crease-angle rule or an explicit h makes them creases.
 pub const DEFAULT_KEEP_HARD_EDGES: bool = false;
@@ -90,8 +90,8 @@ pub struct Options {
     pub max_output_triangles: u64,
     /// Allow `uri`s outside the asset's folder. Default: [`DEFAULT_ALLOW_OUTSIDE_URIS`].
     pub allow_outside_uris: bool,
-    /// Allow overwriting an input. Default: [`DEFAULT_FORCE`].
-    pub force: bool,
+    /// Allow the output to overwrite an input. Default: [`DEFAULT_OVERWRITE_INPUT`].
+    pub overwrite_input: bool,
     /// Give hard edges of the input h = 0. Default: [`DEFAULT_KEEP_HARD_EDGES`].
     pub keep_hard_edges: bool,
     /// Vertex cache and fetch ordering. Default: [`DEFAULT_OPTIMIZE`].
@@ -116,7 +116,7 @@ impl Default for Options {
             scheme: DEFAULT_SCHEME,
             max_output_triangles: DEFAULT_MAX_OUTPUT_TRIANGLES,
             allow_outside_uris: DEFAULT_ALLOW_OUTSIDE_URIS,
-            force: DEFAULT_FORCE,
+            overwrite_input: DEFAULT_OVERWRITE_INPUT,
             keep_hard_edges: DEFAULT_KEEP_HARD_EDGES,
             optimize: DEFAULT_OPTIMIZE,
             overdraw: DEFAULT_OVERDRAW,
@@ -139,7 +139,7 @@ pub struct ConfigFile {
     pub scheme: Option<Scheme>,
     pub max_output_triangles: Option<u64>,
     pub allow_outside_uris: Option<bool>,
-    pub force: Option<bool>,
+    pub overwrite_input: Option<bool>,
     pub keep_hard_edges: Option<bool>,
     pub optimize: Option<bool>,
     pub overdraw: Option<bool>,
@@ -184,7 +184,7 @@ impl Options {
             scheme,
             max_output_triangles,
             allow_outside_uris,
-            force,
+            overwrite_input,
             keep_hard_edges,
             optimize,
             overdraw,

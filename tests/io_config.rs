@@ -16,7 +16,7 @@ fn default_toml_equals_the_defaults_in_code() {
         file.scheme.is_some(),
         file.max_output_triangles.is_some(),
         file.allow_outside_uris.is_some(),
-        file.force.is_some(),
+        file.overwrite_input.is_some(),
         file.quantize.is_some(),
         file.compress.is_some(),
     ];

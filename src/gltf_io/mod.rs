@@ -29,4 +29,4 @@ pub mod write;
 pub use document::{read, read_bytes, Document, ReadOptions};
 pub use error::{Error, ErrorKind, Result};
 pub use primitive::{replace_primitive, Attribute, PrimitiveData, Values};
-pub use write::{write, WriteOptions};
+pub use write::{encode, write, Files, WriteOptions};
