@@ -141,8 +141,8 @@ pub struct Args {
     #[arg(long, help_heading = "Watch", requires = "watch")]
     pub delete: bool,
 
-    /// With --watch: poll the file system instead of using its notifications (network drives,
-    /// containers)
+    /// With --watch: poll instead of using the file system's notifications (network drives,
+    /// some containers); reads every watched file at each scan, so suits modest trees
     #[arg(long, help_heading = "Watch", requires = "watch")]
     pub poll: bool,
 

@@ -27,6 +27,8 @@ use super::{interrupt, Runner, EXIT_OK, EXIT_USAGE};
 
 /// Longest wait for a file whose size keeps changing before it is processed anyway.
 const STABLE_WAIT: Duration = Duration::from_secs(10);
+/// Shortest interval between two scans with `--poll` (each one reads every watched file).
+const MIN_POLL: Duration = Duration::from_millis(500);
 /// Interval between two size checks.
 const STABLE_STEP: Duration = Duration::from_millis(100);
 
@@ -271,8 +273,11 @@ fn start(
         };
         let _ = tx.send(wake);
     };
+    // notify's poller keeps modification times in whole seconds, so a save within the second
+    // of the last scan would go unseen: with --poll it compares contents too.
     let notify_config = notify::Config::default()
-        .with_poll_interval(settings.debounce.max(Duration::from_millis(100)));
+        .with_poll_interval(settings.debounce.max(MIN_POLL))
+        .with_compare_contents(settings.poll);
     let config = Config::default()
         .with_timeout(settings.debounce)
         .with_notify_config(notify_config);
