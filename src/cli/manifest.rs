@@ -1,8 +1,8 @@
 //! Incremental runs: a small manifest beside the outputs (`.g2tess-manifest.json` in the `-o`
-//! folder; named output files and outputs beside their inputs have none) records, per output, a hash of everything its input consisted of (the asset, its
-//! buffer and image files, its sidecar) and a hash of the effective settings, with the size and
-//! modification time of each file written. An output is skipped when both hashes and its files
-//! are unchanged.
+//! folder; named output files and outputs beside their inputs have none) records, per output, a
+//! hash of everything its input consisted of (the asset, its buffer and image files, its
+//! sidecar) and a hash of the effective settings, with the size and modification time of each
+//! file written. An output is skipped when both hashes and its files are unchanged.
 //!
 //! Contents are hashed rather than timestamps compared, because checkouts, copies and archive
 //! tools set timestamps freely. The manifest is a cache: a missing, foreign or corrupt one only
