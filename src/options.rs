@@ -27,8 +27,8 @@ pub const DEFAULT_SCHEME: Scheme = Scheme::G2;
 pub const DEFAULT_MAX_OUTPUT_TRIANGLES: u64 = 50_000_000;
 /// Default: `uri`s may not leave the asset's folder.
 pub const DEFAULT_ALLOW_OUTSIDE_URIS: bool = false;
-/// Default: never overwrite an input file.
-pub const DEFAULT_FORCE: bool = false;
+/// Default: never overwrite an input file (or a buffer or image file it refers to).
+pub const DEFAULT_OVERWRITE_INPUT: bool = false;
 /// Default: hard edges of the input (split normals) are not forced sharp: the surface closes
 /// them smoothly unless the crease-angle rule or an explicit h makes them creases.
 pub const DEFAULT_KEEP_HARD_EDGES: bool = false;
@@ -68,8 +68,8 @@ pub struct Options {
     pub max_output_triangles: u64,
     /// Allow `uri`s outside the asset's folder. Default: [`DEFAULT_ALLOW_OUTSIDE_URIS`].
     pub allow_outside_uris: bool,
-    /// Allow overwriting an input. Default: [`DEFAULT_FORCE`].
-    pub force: bool,
+    /// Allow the output to overwrite an input. Default: [`DEFAULT_OVERWRITE_INPUT`].
+    pub overwrite_input: bool,
     /// Coons shape parameter λ. Default: [`DEFAULT_COONS_LAMBDA`]; range 0.05..=0.95.
     pub coons_lambda: f64,
     /// Coons: choose λ per triangle by thin-plate fairing. Default: [`DEFAULT_COONS_FAIR`].
@@ -101,7 +101,7 @@ impl Default for Options {
             scheme: DEFAULT_SCHEME,
             max_output_triangles: DEFAULT_MAX_OUTPUT_TRIANGLES,
             allow_outside_uris: DEFAULT_ALLOW_OUTSIDE_URIS,
-            force: DEFAULT_FORCE,
+            overwrite_input: DEFAULT_OVERWRITE_INPUT,
             coons_lambda: DEFAULT_COONS_LAMBDA,
             coons_fair: DEFAULT_COONS_FAIR,
             keep_hard_edges: DEFAULT_KEEP_HARD_EDGES,
@@ -127,7 +127,7 @@ pub struct ConfigFile {
     pub scheme: Option<Scheme>,
     pub max_output_triangles: Option<u64>,
     pub allow_outside_uris: Option<bool>,
-    pub force: Option<bool>,
+    pub overwrite_input: Option<bool>,
     pub coons_lambda: Option<f64>,
     pub coons_fair: Option<bool>,
     pub keep_hard_edges: Option<bool>,
@@ -175,7 +175,7 @@ impl Options {
             scheme,
             max_output_triangles,
             allow_outside_uris,
-            force,
+            overwrite_input,
             coons_lambda,
             coons_fair,
             keep_hard_edges,

@@ -1,6 +1,6 @@
 //! Exit statuses and the safety rules of the command line: 0 all done, 1 some input failed (the
 //! others still processed), 2 usage or configuration error; outputs written atomically; inputs
-//! never overwritten unless forced.
+//! never overwritten unless `--overwrite-input` is given.
 
 mod corpus;
 
@@ -104,7 +104,7 @@ fn identity_run_exits_0_and_writes_gltf_with_bin() {
 }
 
 #[test]
-fn input_is_not_overwritten_unless_forced() {
+fn input_is_not_overwritten_without_overwrite_input() {
     let dir = corpus::temp_dir();
     let input = dir.path().join("in.glb");
     std::fs::copy(example(), &input).unwrap();
@@ -116,13 +116,13 @@ fn input_is_not_overwritten_unless_forced() {
         .output()
         .unwrap();
     assert_eq!(run.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&run.stderr).contains("--force"));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("--overwrite-input"));
     assert_eq!(std::fs::read(&input).unwrap(), before);
     let run = corpus::g2tess()
         .arg(&input)
         .arg("-o")
         .arg(&input)
-        .arg("--force")
+        .arg("--overwrite-input")
         .output()
         .unwrap();
     assert_eq!(run.status.code(), Some(0));

@@ -10,17 +10,22 @@ use g2tess::options::{self, ConfigError, ConfigFile, Options};
 
 /// Turns low-poly glTF meshes into dense, watertight G²-smooth meshes with exact normals.
 ///
+/// Inputs are files and folders; folders are searched (sorted) for .gltf and .glb files, and
+/// their outputs mirror the folder tree under -o. A g2tess.toml in a folder sets the defaults
+/// of the assets below it (the nearest one wins; flags still override it).
+///
 /// Exit status: 0 every input done, 1 some input failed (the others were still processed),
 /// 2 usage or configuration error.
 #[derive(Debug, Parser)]
 #[command(name = "g2tess", version, about, long_about = None, after_help = EXIT_HELP)]
 pub struct Args {
-    /// Input .gltf or .glb files
+    /// Input .gltf or .glb files, or folders to search for them
     #[arg(required = true, value_name = "INPUT")]
     pub inputs: Vec<PathBuf>,
 
-    /// Output file (.glb or .gltf), or a folder when there are several inputs
-    /// [default: INPUT's name with .smooth before the extension, beside it]
+    /// Output file (one input file), or folder (several inputs, or a folder input: outputs mirror
+    /// the input folders below it) [default: INPUT's name with .smooth before the extension,
+    /// beside it; a folder input needs -o]
     #[arg(short, long, value_name = "PATH")]
     pub output: Option<PathBuf>,
 
@@ -68,7 +73,8 @@ pub struct Args {
     #[arg(long, value_name = "MESH", help_heading = "Surface")]
     pub explain_h: Option<String>,
 
-    /// Write a JSON report (counts, timings, continuity, warnings per file) to FILE
+    /// Write a JSON report to FILE: one record per input (status, error, counts, sizes, times,
+    /// continuity), field names as in the README
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub report: Option<PathBuf>,
 
@@ -97,16 +103,68 @@ pub struct Args {
     #[arg(long, help_heading = "Output", requires = "compress")]
     pub compress_fallback: bool,
 
-    /// Allow overwriting an input file
+    /// Allow an output to replace an input file (or a buffer or image file it refers to)
     #[arg(long, help_heading = "Safety")]
-    pub force: bool,
+    pub overwrite_input: bool,
 
     /// Allow uris that leave the asset's folder (.., absolute paths); network uris are never read
     #[arg(long, help_heading = "Safety")]
     pub allow_outside_uris: bool,
+
+    /// Files processed at once; each one in flight holds its document in memory
+    /// [default: the number of CPUs]
+    #[arg(short, long, value_name = "N", help_heading = "Batch")]
+    pub jobs: Option<usize>,
+
+    /// Only take assets found in folders whose path below the folder matches GLOB (`*.glb`,
+    /// `props/**`); a GLOB without `/` matches the file name. Repeatable
+    #[arg(long, value_name = "GLOB", help_heading = "Batch")]
+    pub include: Vec<String>,
+
+    /// Skip assets and folders whose path below the searched folder matches GLOB; wins over
+    /// --include. Repeatable
+    #[arg(long, value_name = "GLOB", help_heading = "Batch")]
+    pub exclude: Vec<String>,
+
+    /// Process every input again, even when its output is up to date
+    #[arg(long, help_heading = "Batch")]
+    pub force: bool,
+
+    /// Write nothing; exit 1 if any output is missing or differs from what a run would write
+    #[arg(long, help_heading = "Batch", conflicts_with_all = ["watch", "force"])]
+    pub check: bool,
+
+    /// Stop at the first failed input (files already started still finish)
+    #[arg(long, help_heading = "Batch")]
+    pub fail_fast: bool,
+
+    /// Print errors only
+    #[arg(short, long, help_heading = "Batch", conflicts_with = "verbose")]
+    pub quiet: bool,
+
+    /// Also print skipped files and every warning
+    #[arg(short, long, help_heading = "Batch")]
+    pub verbose: bool,
+
+    /// After the first run, keep watching the inputs and process what changes (Ctrl-C stops)
+    #[arg(long, help_heading = "Watch")]
+    pub watch: bool,
+
+    /// With --watch: delete the outputs of deleted inputs
+    #[arg(long, help_heading = "Watch", requires = "watch")]
+    pub delete: bool,
+
+    /// With --watch: poll instead of using the file system's notifications (network drives,
+    /// some containers); reads every watched file at each scan, so suits modest trees
+    #[arg(long, help_heading = "Watch", requires = "watch")]
+    pub poll: bool,
+
+    /// With --watch: wait until files have been quiet this many milliseconds [default: 200]
+    #[arg(long, value_name = "MS", help_heading = "Watch", requires = "watch")]
+    pub debounce: Option<u64>,
 }
 
-const EXIT_HELP: &str = "Exit status: 0 every input done, 1 some input failed (the others were still processed), 2 usage or configuration error.";
+const EXIT_HELP: &str = "Exit status: 0 every input done (or up to date), 1 some input failed or, with --check, some output is not current (the others were still processed), 2 usage or configuration error, 130 stopped by Ctrl-C before the end (the files in flight were finished; --watch ends with 0).";
 
 /// `--profile` values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -131,9 +189,10 @@ pub enum SchemeArg {
 }
 
 impl Args {
-    /// Resolves defaults ← config file ← flags into one checked [`Options`].
-    pub fn options(&self) -> Result<Options, ConfigError> {
-        let mut opts = Options::default();
+    /// The settings in their layers, so that a folder's `g2tess.toml` can slot in between the
+    /// `--config` file and the flags.
+    pub fn layers(&self) -> Result<Layers, ConfigError> {
+        let mut base = Options::default();
         if let Some(path) = &self.config {
             let shown = path.display().to_string();
             let text = std::fs::read_to_string(path).map_err(|e| ConfigError {
@@ -141,10 +200,20 @@ impl Args {
                 what: e.to_string().to_lowercase(),
             })?;
             let file = ConfigFile::parse(&text, &shown)?;
-            opts = opts.overlay(&file);
-            opts.validate(&shown)?;
+            base = base.overlay(&file);
+            base.validate(&shown)?;
         }
-        let flags = ConfigFile {
+        let layers = Layers {
+            base,
+            flags: self.flag_settings(),
+            sidecar: self.sidecar.clone(),
+        };
+        layers.resolve(None)?;
+        Ok(layers)
+    }
+
+    fn flag_settings(&self) -> ConfigFile {
+        ConfigFile {
             level: self.level,
             h: self.h,
             crease_angle: self.crease_angle,
@@ -160,17 +229,38 @@ impl Args {
             }),
             max_output_triangles: self.max_triangles,
             allow_outside_uris: self.allow_outside_uris.then_some(true),
-            force: self.force.then_some(true),
             coons_lambda: self.coons_lambda,
             coons_fair: self.coons_fair.then_some(true),
+            overwrite_input: self.overwrite_input.then_some(true),
             keep_hard_edges: self.keep_hard_edges.then_some(true),
             optimize: self.no_optimize.then_some(false),
             overdraw: self.overdraw.then_some(true),
             quantize: self.quantize.then_some(true),
             compress: self.compress.then_some(true),
             compress_fallback: self.compress_fallback.then_some(true),
-        };
-        let mut opts = opts.overlay(&flags);
+        }
+    }
+}
+
+/// Settings before a folder's `g2tess.toml` is known: defaults with `--config` applied, and the
+/// flags that override everything.
+#[derive(Debug, Clone)]
+pub struct Layers {
+    base: Options,
+    flags: ConfigFile,
+    sidecar: Option<PathBuf>,
+}
+
+impl Layers {
+    /// The options of an asset under the folder config `dir` (its parsed text and its file name
+    /// for messages): base ← folder config ← flags.
+    pub fn resolve(&self, dir: Option<(&ConfigFile, &str)>) -> Result<Options, ConfigError> {
+        let mut opts = self.base.clone();
+        if let Some((file, origin)) = dir {
+            opts = opts.overlay(file);
+            opts.validate(origin)?;
+        }
+        let mut opts = opts.overlay(&self.flags);
         opts.sidecar = self.sidecar.clone();
         opts.validate("command line")?;
         Ok(opts)

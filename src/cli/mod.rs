@@ -1,21 +1,42 @@
-//! The binary's edge: parses [`args::Args`] once, resolves [`g2tess::options::Options`], runs
-//! the pipeline on every input, prints errors and chooses the exit status.
+//! The binary's edge: parses [`args::Args`] once, resolves the settings, plans the jobs
+//! ([`scope`]), runs them ([`batch`]) once or on every change ([`watch`]), prints ([`progress`]),
+//! writes the JSON report ([`report`]) and chooses the exit status.
 //!
 //! It deliberately keeps going after a failed input (the failure shows in the exit status), like
-//! any batch tool.
+//! any batch tool. Walking folders and watching them happen here, never in the library.
 
 mod args;
+mod batch;
+mod dir_config;
+mod interrupt;
+mod manifest;
+mod progress;
+mod report;
+mod scope;
+mod watch;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 use clap::Parser;
 
+use batch::{Outcome, RunSettings, Summary};
+use dir_config::DirConfigs;
+use manifest::Manifests;
+use progress::{Progress, Verbosity};
+use scope::{Job, Scope};
+
 /// Every input processed.
 pub const EXIT_OK: i32 = 0;
-/// At least one input failed; the others were processed.
+/// At least one input failed (or, with `--check`, is out of date); the others were processed.
 pub const EXIT_SOME_FAILED: i32 = 1;
 /// The command line or the configuration is wrong; nothing was processed.
 pub const EXIT_USAGE: i32 = 2;
+/// Ctrl-C stopped a run before every input was processed.
+pub const EXIT_INTERRUPTED: i32 = 130;
+
+/// Default of `--debounce`, in milliseconds.
+const DEFAULT_DEBOUNCE_MS: u64 = 200;
 
 /// Runs the command line; returns the exit status.
 pub fn run() -> i32 {
@@ -27,48 +48,149 @@ pub fn run() -> i32 {
             return code;
         }
     };
-    let options = match args.options() {
-        Ok(o) => o,
-        Err(e) => {
-            eprintln!("g2tess: error: {e}");
-            return EXIT_USAGE;
-        }
+    let layers = match args.layers() {
+        Ok(l) => l,
+        Err(e) => return usage_error(&e.to_string()),
     };
     if let Some(mesh) = &args.explain_h {
-        return explain_h(&args.inputs, &options, mesh);
+        return explain_h(&args.inputs, &layers, mesh);
     }
-    let outputs = match output_paths(&args.inputs, args.output.as_deref()) {
-        Ok(o) => o,
-        Err(msg) => {
-            eprintln!("g2tess: error: {msg}");
-            return EXIT_USAGE;
-        }
+    let scope = match Scope::new(
+        &args.inputs,
+        args.output.as_deref(),
+        &args.include,
+        &args.exclude,
+    ) {
+        Ok(s) => s,
+        Err(e) => return usage_error(&e),
     };
-    let mut status = EXIT_OK;
-    for (input, output) in args.inputs.iter().zip(&outputs) {
-        match g2tess::pipeline::process_file(input, output, &options) {
-            Ok(r) => eprintln!(
-                "g2tess: {} -> {}: {} primitives, {} -> {} triangles",
-                input.display(),
-                output.display(),
-                r.primitives,
-                r.triangles_in,
-                r.triangles_out
-            ),
-            Err(e) => {
+    let jobs = match scope.jobs() {
+        Ok(j) => j,
+        Err(e) => return usage_error(&e),
+    };
+    if args.jobs == Some(0) {
+        return usage_error("command line: jobs: is 0 (expected at least 1)");
+    }
+    let threads = args.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    // The pipeline spreads each file's meshes over rayon's pool; size it like the file workers.
+    let _ = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global();
+    interrupt::install();
+
+    let verbosity = match (args.quiet, args.verbose) {
+        (true, _) => Verbosity::Quiet,
+        (_, true) => Verbosity::Verbose,
+        _ => Verbosity::Normal,
+    };
+    if jobs.is_empty() && verbosity > Verbosity::Quiet {
+        eprintln!("g2tess: no .gltf or .glb file found in the inputs");
+    }
+    let runner = Runner {
+        layers: &layers,
+        settings: RunSettings {
+            jobs: threads,
+            force: args.force,
+            check: args.check,
+            fail_fast: args.fail_fast,
+        },
+        verbosity,
+        report: args.report.clone(),
+        summary_always: args.inputs.len() > 1 || args.inputs.iter().any(|i| i.is_dir()),
+        status: std::cell::Cell::new(EXIT_OK),
+    };
+    if args.watch {
+        let settings = watch::WatchSettings {
+            delete: args.delete,
+            poll: args.poll,
+            debounce: Duration::from_millis(args.debounce.unwrap_or(DEFAULT_DEBOUNCE_MS)),
+        };
+        return watch::run(&runner, &scope, jobs, settings);
+    }
+    let mut manifests = Manifests::load(&jobs);
+    runner.round(&jobs, &mut manifests, true);
+    runner.status.get()
+}
+
+fn usage_error(message: &str) -> i32 {
+    eprintln!("g2tess: error: {message}");
+    EXIT_USAGE
+}
+
+/// Runs rounds of jobs with the settings of the command line.
+pub struct Runner<'a> {
+    layers: &'a args::Layers,
+    settings: RunSettings,
+    verbosity: Verbosity,
+    report: Option<PathBuf>,
+    /// Print the summary line even for a single file.
+    summary_always: bool,
+    /// The exit status of the last round.
+    status: std::cell::Cell<i32>,
+}
+
+impl Runner<'_> {
+    /// Processes `jobs` (reading folder configs afresh), prints, saves the manifests, writes
+    /// the report; sets [`Runner::status`].
+    pub fn round(&self, jobs: &[Job], manifests: &mut Manifests, first: bool) -> Vec<Outcome> {
+        let started = Instant::now();
+        let mut configs = DirConfigs::new(self.layers);
+        let options: Vec<_> = jobs.iter().map(|j| configs.options(j)).collect();
+        let progress = Progress::new(jobs.len(), self.verbosity);
+        let outcomes = batch::run(
+            jobs,
+            &options,
+            manifests,
+            self.settings,
+            interrupt::flag(),
+            &progress,
+        );
+        let summary = Summary::of(&outcomes, started);
+        let show = self.summary_always && (first || jobs.len() > 1)
+            || self.verbosity == Verbosity::Verbose;
+        progress.finish(&summary, self.settings.check, show);
+        self.save(manifests);
+        let mut status = match summary.any_failure() {
+            true => EXIT_SOME_FAILED,
+            false => EXIT_OK,
+        };
+        if summary.cancelled > 0 && interrupt::requested() {
+            status = EXIT_INTERRUPTED;
+        }
+        if let Some(file) = &self.report {
+            let written =
+                report::write(file, jobs, &outcomes, &summary, self.settings.check, status);
+            if let Err(e) = written {
                 eprintln!("g2tess: error: {e}");
-                status = EXIT_SOME_FAILED;
+                status = status.max(EXIT_SOME_FAILED);
             }
         }
+        self.status.set(status);
+        outcomes
     }
-    status
+
+    /// Saves the manifests (never with `--check`); a failure only costs the next run its skips.
+    pub fn save(&self, manifests: &mut Manifests) {
+        if self.settings.check {
+            return;
+        }
+        if let Err(e) = manifests.save() {
+            eprintln!("g2tess: warning: {e}: the next run will process every file again");
+        }
+    }
 }
 
 /// `--explain-h MESH`: prints, per input, which source set each edge's h; writes nothing.
-fn explain_h(inputs: &[PathBuf], options: &g2tess::options::Options, mesh: &str) -> i32 {
+fn explain_h(inputs: &[PathBuf], layers: &args::Layers, mesh: &str) -> i32 {
+    let options = match layers.resolve(None) {
+        Ok(o) => o,
+        Err(e) => return usage_error(&e.to_string()),
+    };
     let mut status = EXIT_OK;
     for input in inputs {
-        match g2tess::pipeline::explain_h(input, options, mesh) {
+        match g2tess::pipeline::explain_h(input, &options, mesh) {
             Ok(lines) => {
                 println!("{}: mesh {mesh}", input.display());
                 for line in lines {
@@ -82,30 +204,4 @@ fn explain_h(inputs: &[PathBuf], options: &g2tess::options::Options, mesh: &str)
         }
     }
     status
-}
-
-/// `name.glb` → `name.smooth.glb`.
-fn smooth_name(input: &Path) -> PathBuf {
-    let stem = input.file_stem().unwrap_or_default().to_string_lossy();
-    let ext = input
-        .extension()
-        .map_or("glb".into(), |e| e.to_string_lossy());
-    input.with_file_name(format!("{stem}.smooth.{ext}"))
-}
-
-/// Where each input's output goes: `-o` as a file (one input) or a folder (any number).
-fn output_paths(inputs: &[PathBuf], output: Option<&Path>) -> Result<Vec<PathBuf>, String> {
-    match output {
-        None => Ok(inputs.iter().map(|i| smooth_name(i)).collect()),
-        Some(dir) if dir.is_dir() => Ok(inputs
-            .iter()
-            .map(|i| dir.join(i.file_name().unwrap_or_default()))
-            .collect()),
-        Some(file) if inputs.len() == 1 => Ok(vec![file.to_path_buf()]),
-        Some(file) => Err(format!(
-            "{}: -o with {} inputs must be an existing folder (expected e.g. -o out/)",
-            file.display(),
-            inputs.len()
-        )),
-    }
 }

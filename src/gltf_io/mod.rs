@@ -37,4 +37,4 @@ pub use error::{Error, ErrorKind, Result};
 pub use meshopt_encode::Compression;
 pub use primitive::{replace_primitive, Attribute, PrimitiveData, Values};
 pub use quantize::{quantize, Quantization};
-pub use write::{fallback_path, write, WriteOptions};
+pub use write::{encode, fallback_path, write, Files, WriteOptions};

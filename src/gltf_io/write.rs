@@ -52,8 +52,22 @@ pub fn fallback_path(path: &Path) -> PathBuf {
     path.with_extension("fallback.bin")
 }
 
+/// The files of one output, each with its bytes, in the order they are written.
+pub type Files = Vec<(PathBuf, Vec<u8>)>;
+
 /// Writes `doc` to `path` (`.glb`, or `.gltf` + `<stem>.bin`).
 pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
+    for (file, bytes) in encode(doc, path, opts)? {
+        atomic_write(&file, &bytes)?;
+    }
+    Ok(())
+}
+
+/// The files [`write`] would create for `path`, with their bytes, in the order it writes them
+/// (a `.gltf`'s `.bin` before the `.gltf` that refers to it), without touching the disk.
+///
+/// It exists so that a caller can compare a fresh result with what is on disk (`--check`).
+pub fn encode(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<Files> {
     let shown = path.display().to_string();
     let ext = path
         .extension()
@@ -92,14 +106,16 @@ pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
     }
     if as_glb {
         let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
-        atomic_write(path, &glb::assemble(&text, &bin))
+        Ok(vec![(path.to_path_buf(), glb::assemble(&text, &bin))])
     } else {
         let mut text = serde_json::to_vec_pretty(&json).map_err(|e| Error::invalid(&shown, e))?;
         text.push(b'\n');
+        let mut files = Vec::with_capacity(2);
         if let Some(bin_path) = bin_path.filter(|_| !bin.is_empty()) {
-            atomic_write(&bin_path, &bin)?;
+            files.push((bin_path, bin));
         }
-        atomic_write(path, &text)
+        files.push((path.to_path_buf(), text));
+        Ok(files)
     }
 }
 
@@ -153,7 +169,7 @@ fn refuse_overwriting_input(
             return Err(Error::invalid(
                 out.display(),
                 format!(
-                    "would overwrite the input {} (pass --force to allow it)",
+                    "would overwrite the input {} (pass --overwrite-input to allow it)",
                     input.display()
                 ),
             ));

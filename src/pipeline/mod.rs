@@ -31,23 +31,46 @@ pub use report::{FileReport, MeshReport, PrimitiveReport, StageTimes};
 /// Reads `input`, processes it and writes `output` atomically.
 pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<FileReport, Error> {
     let started = Instant::now();
+    let (mut report, files) = encode_file(input, output, options)?;
+    let write_start = Instant::now();
+    for (file, bytes) in &files {
+        gltf_io::write::atomic_write(file, bytes).map_err(|e| Error::gltf(output, e))?;
+    }
+    report.times.write += write_start.elapsed().as_secs_f64();
+    report.times.total = started.elapsed().as_secs_f64();
+    report.bytes_out = file_size(output);
+    Ok(report)
+}
+
+/// Does everything [`process_file`] does except writing: returns the files it would write
+/// (see [`gltf_io::encode`]) with their bytes, so that a caller can compare them with what is
+/// on disk without touching it.
+pub fn encode_file(
+    input: &Path,
+    output: &Path,
+    options: &Options,
+) -> Result<(FileReport, gltf_io::Files), Error> {
+    let started = Instant::now();
     let located = |e: gltf_io::Error| Error::gltf(input, e);
     let mut doc = gltf_io::read(input, &options.read_options()).map_err(located)?;
     let read_s = started.elapsed().as_secs_f64();
     let mut report = process_document(&mut doc, input, options)?;
-    let write_start = Instant::now();
+    let encode_start = Instant::now();
     if let Some(q) = options.quantization() {
         gltf_io::quantize(&mut doc, &q).map_err(located)?;
     }
-    let write = WriteOptions::new(Some(input.to_path_buf()), options.force)
+    let write = WriteOptions::new(Some(input.to_path_buf()), options.overwrite_input)
         .with_compression(options.compression());
-    gltf_io::write(&doc, output, &write).map_err(|e| Error::gltf(output, e))?;
+    let files = gltf_io::encode(&doc, output, &write).map_err(|e| Error::gltf(output, e))?;
     report.times.read = read_s;
-    report.times.write = write_start.elapsed().as_secs_f64();
+    report.times.write = encode_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
     report.bytes_in = file_size(input);
-    report.bytes_out = file_size(output);
-    Ok(report)
+    report.bytes_out = files
+        .iter()
+        .find(|(f, _)| f == output)
+        .map_or(0, |(_, b)| b.len() as u64);
+    Ok((report, files))
 }
 
 fn file_size(path: &Path) -> u64 {

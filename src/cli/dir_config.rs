@@ -1,0 +1,74 @@
+//! Folder settings: a `g2tess.toml` in a folder sets the defaults of the assets below it, the
+//! nearest one winning, so that a project keeps its settings in its asset tree.
+//!
+//! The search goes up from the asset's folder to the folder named on the command line (a file
+//! input: its own folder) and no further, so the settings of a run depend only on what it was
+//! given. A folder config slots in between `--config` and the flags (see [`Layers`]); sidecars
+//! beside each asset are found later, by the pipeline.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use g2tess::options::{ConfigFile, Options};
+
+use super::args::Layers;
+use super::scope::{parent_dir, Job};
+
+/// The file name of a folder's settings.
+pub const DIR_CONFIG: &str = "g2tess.toml";
+
+/// Resolves each job's options, reading every folder config once.
+pub struct DirConfigs<'a> {
+    layers: &'a Layers,
+    /// Folder → its parsed config (`None`: the folder has none).
+    parsed: HashMap<PathBuf, Option<Result<ConfigFile, String>>>,
+}
+
+impl<'a> DirConfigs<'a> {
+    pub fn new(layers: &'a Layers) -> Self {
+        DirConfigs {
+            layers,
+            parsed: HashMap::new(),
+        }
+    }
+
+    /// The options of `job`'s asset; the error is a message naming the config file and line.
+    pub fn options(&mut self, job: &Job) -> Result<Options, String> {
+        let Some((file, config)) = self.nearest(job)? else {
+            return self.layers.resolve(None).map_err(|e| e.to_string());
+        };
+        let origin = file.display().to_string();
+        self.layers
+            .resolve(Some((&config, &origin)))
+            .map_err(|e| e.to_string())
+    }
+
+    fn nearest(&mut self, job: &Job) -> Result<Option<(PathBuf, ConfigFile)>, String> {
+        let mut dir = parent_dir(&job.input).to_path_buf();
+        loop {
+            let found = self
+                .parsed
+                .entry(dir.clone())
+                .or_insert_with(|| read(&dir.join(DIR_CONFIG)));
+            if let Some(result) = found {
+                return result.clone().map(|c| Some((dir.join(DIR_CONFIG), c)));
+            }
+            if dir == job.config_root || !dir.starts_with(&job.config_root) {
+                return Ok(None);
+            }
+            dir = parent_dir(&dir).to_path_buf();
+        }
+    }
+}
+
+fn read(file: &Path) -> Option<Result<ConfigFile, String>> {
+    if !file.is_file() {
+        return None;
+    }
+    let shown = file.display().to_string();
+    Some(
+        std::fs::read_to_string(file)
+            .map_err(|e| format!("{shown}: {}", e.to_string().to_lowercase()))
+            .and_then(|text| ConfigFile::parse(&text, &shown).map_err(|e| e.to_string())),
+    )
+}

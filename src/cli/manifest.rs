@@ -1,0 +1,261 @@
+//! Incremental runs: a small manifest beside the outputs (`.g2tess-manifest.json` in the `-o`
+//! folder; named output files and outputs beside their inputs have none) records, per output, a
+//! hash of everything its input consisted of (the asset, its buffer and image files, its
+//! sidecar) and a hash of the effective settings, with the size and modification time of each
+//! file written. An output is skipped when both hashes and its files are unchanged.
+//!
+//! Contents are hashed rather than timestamps compared, because checkouts, copies and archive
+//! tools set timestamps freely. The manifest is a cache: a missing, foreign or corrupt one only
+//! means everything is processed again. It deliberately records nothing about failed files.
+
+use std::collections::BTreeMap;
+use std::hash::Hasher as _;
+use std::path::{Path, PathBuf};
+
+use g2tess::gltf_io::{glb, uri};
+use g2tess::options::Options;
+use g2tess::sharpness::sidecar_path_for;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use super::scope::{parent_dir, Job};
+
+/// The manifest's file name in each output folder.
+pub const MANIFEST_NAME: &str = ".g2tess-manifest.json";
+/// Bumped when the format changes; older manifests are ignored.
+const FORMAT: u32 = 1;
+
+/// What an output was made from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Fingerprint {
+    /// Hash of the asset, its buffer and image files, and its sidecar (or their absence).
+    pub inputs: String,
+    /// Hash of the tool's version and the effective options.
+    pub settings: String,
+    /// Every file hashed into `inputs`, as the asset's path names them (for watching).
+    pub files: Vec<PathBuf>,
+}
+
+impl Fingerprint {
+    /// Reads and hashes what `job` is made of under `options`. Never fails: an unreadable file
+    /// hashes as absent, and the pipeline reports why it cannot be read.
+    pub fn of(job: &Job, options: &Options) -> Fingerprint {
+        let mut files = vec![job.input.clone()];
+        let bytes = std::fs::read(&job.input).ok();
+        if let Some(bytes) = &bytes {
+            files.extend(companions(&job.input, bytes, options.allow_outside_uris));
+        }
+        files.push(match &options.sidecar {
+            Some(s) => s.clone(),
+            None => sidecar_path_for(&job.input),
+        });
+        let mut h = fnv::FnvHasher::default();
+        for (i, file) in files.iter().enumerate() {
+            h.write(file.file_name().unwrap_or_default().as_encoded_bytes());
+            let content = if i == 0 {
+                bytes.as_deref().map(hash)
+            } else {
+                std::fs::read(file).ok().map(|b| hash(&b))
+            };
+            match content {
+                Some(c) => h.write_u64(c),
+                None => h.write(b"\0absent"),
+            }
+        }
+        let settings = format!("{} {options:?}", env!("CARGO_PKG_VERSION"));
+        Fingerprint {
+            inputs: format!("{:016x}", h.finish()),
+            settings: format!("{:016x}", hash(settings.as_bytes())),
+            files,
+        }
+    }
+}
+
+fn hash(bytes: &[u8]) -> u64 {
+    let mut h = fnv::FnvHasher::default();
+    h.write(bytes);
+    h.finish()
+}
+
+/// The buffer and image files a `.gltf` or `.glb` refers to, in document order.
+fn companions(asset: &Path, bytes: &[u8], allow_outside: bool) -> Vec<PathBuf> {
+    let json = match glb::is_glb(bytes) {
+        true => glb::split(bytes).map(|c| c.json).unwrap_or_default(),
+        false => bytes,
+    };
+    let Ok(root) = serde_json::from_slice::<Value>(json) else {
+        return Vec::new();
+    };
+    let base = parent_dir(asset);
+    ["buffers", "images"]
+        .iter()
+        .filter_map(|k| root.get(*k).and_then(Value::as_array))
+        .flatten()
+        .filter_map(|o| o.get("uri").and_then(Value::as_str))
+        .filter_map(
+            |u| match uri::resolve(u, "uri", Some(base), allow_outside) {
+                Ok(uri::Target::File(f)) => Some(f),
+                _ => None,
+            },
+        )
+        .collect()
+}
+
+/// One written file: enough to notice that someone replaced or removed it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Stamp {
+    pub size: u64,
+    pub mtime_ns: u64,
+}
+
+impl Stamp {
+    pub fn of(file: &Path) -> Option<Stamp> {
+        let meta = std::fs::metadata(file).ok()?;
+        let mtime = meta
+            .modified()
+            .ok()?
+            .duration_since(std::time::UNIX_EPOCH)
+            .ok()?;
+        Some(Stamp {
+            size: meta.len(),
+            mtime_ns: u64::try_from(mtime.as_nanos()).unwrap_or(u64::MAX),
+        })
+    }
+}
+
+/// One output's record.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Entry {
+    pub inputs: String,
+    pub settings: String,
+    /// Every file written (the output, a `.gltf`'s `.bin`), by name relative to the manifest.
+    pub outputs: BTreeMap<String, Stamp>,
+}
+
+#[derive(Debug, Default, Serialize, Deserialize)]
+struct File {
+    format: u32,
+    files: BTreeMap<String, Entry>,
+}
+
+/// The manifests of every output folder of a run.
+#[derive(Debug, Default)]
+pub struct Manifests {
+    folders: BTreeMap<PathBuf, File>,
+    dirty: bool,
+}
+
+impl Manifests {
+    /// Loads the manifest of every folder these jobs write to (absent or unreadable: empty).
+    pub fn load(jobs: &[Job]) -> Manifests {
+        let mut m = Manifests::default();
+        for dir in jobs.iter().filter_map(|j| j.manifest_dir.as_deref()) {
+            m.folder(dir);
+        }
+        m
+    }
+
+    fn folder(&mut self, dir: &Path) -> &mut File {
+        self.folders.entry(dir.to_path_buf()).or_insert_with(|| {
+            std::fs::read(dir.join(MANIFEST_NAME))
+                .ok()
+                .and_then(|b| serde_json::from_slice::<File>(&b).ok())
+                .filter(|f| f.format == FORMAT)
+                .unwrap_or_default()
+        })
+    }
+
+    /// Whether `job`'s outputs on disk were made from exactly `fp`.
+    pub fn is_current(&self, job: &Job, fp: &Fingerprint) -> bool {
+        let Some(dir) = &job.manifest_dir else {
+            return false;
+        };
+        let Some(entry) = self.folders.get(dir).and_then(|f| f.files.get(&job.key)) else {
+            return false;
+        };
+        entry.inputs == fp.inputs
+            && entry.settings == fp.settings
+            && !entry.outputs.is_empty()
+            && entry
+                .outputs
+                .iter()
+                .all(|(name, stamp)| Stamp::of(&dir.join(name)) == Some(*stamp))
+    }
+
+    /// Records the files just written for `job`.
+    pub fn record(&mut self, job: &Job, fp: &Fingerprint) {
+        let Some(dir) = &job.manifest_dir else {
+            return;
+        };
+        let mut outputs = BTreeMap::new();
+        for file in written_files(&job.output) {
+            // A `.gltf` without binary data has no `.bin`.
+            if let Some(stamp) = Stamp::of(&file) {
+                let name = file
+                    .strip_prefix(dir)
+                    .unwrap_or(&file)
+                    .to_string_lossy()
+                    .replace(std::path::MAIN_SEPARATOR, "/");
+                outputs.insert(name, stamp);
+            }
+        }
+        let entry = Entry {
+            inputs: fp.inputs.clone(),
+            settings: fp.settings.clone(),
+            outputs,
+        };
+        self.folder(dir).files.insert(job.key.clone(), entry);
+        self.dirty = true;
+    }
+
+    /// Forgets `job` (its output failed, or its input was deleted).
+    pub fn forget(&mut self, job: &Job) {
+        let Some(dir) = &job.manifest_dir else {
+            return;
+        };
+        if self.folder(dir).files.remove(&job.key).is_some() {
+            self.dirty = true;
+        }
+    }
+
+    /// Writes every changed manifest atomically; the error names the file.
+    pub fn save(&mut self) -> Result<(), String> {
+        if !std::mem::take(&mut self.dirty) {
+            return Ok(());
+        }
+        for (dir, file) in &mut self.folders {
+            file.format = FORMAT;
+            if file.files.is_empty() && !dir.join(MANIFEST_NAME).exists() {
+                continue;
+            }
+            let mut text = serde_json::to_vec_pretty(file).map_err(|e| e.to_string())?;
+            text.push(b'\n');
+            g2tess::gltf_io::write::atomic_write(&dir.join(MANIFEST_NAME), &text)
+                .map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    }
+}
+
+/// The files writing `output` may create: the output, and a `.gltf`'s `.bin`.
+pub fn written_files(output: &Path) -> Vec<PathBuf> {
+    let mut files = vec![output.to_path_buf()];
+    let gltf = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
+    if gltf {
+        files.push(output.with_extension("bin"));
+    }
+    files
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_hash_is_fnv1a_64() {
+        // Published test vector: FNV-1a 64 of "a".
+        assert_eq!(hash(b"a"), 0xaf63_dc4c_8601_ec8c);
+    }
+}
