@@ -12,16 +12,23 @@
 //!   neighbour.
 //! - [`sharpness`]: resolves one blend width `h` per welded edge from glTF extras, sidecar TOML,
 //!   the crease-angle rule and the defaults.
+//! - [`normals`]: vertex normals for meshes that come without them.
 //! - [`surface`]: the smooth surfaces over a whole mesh behind the [`surface::Surface`] trait
-//!   ([`surface::PnSurface`], and [`surface::G2Surface`], the G² blend of Lee–Hwang–Yoon), evaluated
-//!   with exact normals at any domain point of any triangle, or over a whole lattice with cached
-//!   per-(level, h, profile) weights.
+//!   ([`surface::PnSurface`], [`surface::G2Surface`] (the G² blend of Lee–Hwang–Yoon), and the
+//!   `hybrid` and `coons` schemes chosen with [`surface::Scheme`]), evaluated with exact normals
+//!   at any domain point of any triangle, or over a whole lattice with cached weights.
 //! - [`continuity`]: measures position gap, normal jump and curvature jump across edges
 //!   ([`continuity::measure`]).
+//! - [`tessellate`]: the level-n lattice of every triangle, shared edge and corner samples
+//!   evaluated once (watertight), output vertices split where the input was.
+//! - [`attributes`]: carries texture coordinates, colors, skin weights and IDs to new vertices.
+//! - [`tangents`]: MikkTSpace tangents for the dense output.
+//! - [`optimize`]: meshoptimizer's vertex cache and fetch ordering.
 //! - [`options`]: the resolved settings that flow down through every stage.
 //! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages.
 //!
-//! **Architecture invariant:** [`mesh`], [`topology`], [`surface`] and [`continuity`] take slices
+//! **Architecture invariant:** [`mesh`], [`topology`], [`surface`], [`continuity`],
+//! [`tessellate`], [`attributes`] and [`normals`] take slices
 //! and return values; they know nothing of glTF, files, clap or meshopt, and never fail on bad
 //! geometry (they fall back and report).
 //!

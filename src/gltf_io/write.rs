@@ -63,7 +63,7 @@ pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
     Ok(())
 }
 
-/// The files [`write`] would create for `path`, with their bytes, in the order it writes them
+/// The files [`write()`] would create for `path`, with their bytes, in the order it writes them
 /// (a `.gltf`'s `.bin` before the `.gltf` that refers to it), without touching the disk.
 ///
 /// It exists so that a caller can compare a fresh result with what is on disk (`--check`).
