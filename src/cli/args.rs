@@ -80,7 +80,8 @@ pub struct Args {
     #[arg(long, help_heading = "Output")]
     pub overdraw: bool,
 
-    /// Refuse outputs with more triangles than this per file [default: 50000000]
+    /// Refuse outputs with more triangles than this per file (about 500 bytes of memory each)
+    /// [default: 20000000]
     #[arg(long, value_name = "N", help_heading = "Output")]
     pub max_triangles: Option<u64>,
 

@@ -83,6 +83,9 @@ pub fn smooth_mesh(
     assign_offsets(&mut prepared);
     let (mesh, groups) = join(&prepared);
     let topo = Topology::build(&mesh);
+    report
+        .warnings
+        .extend(super::checks::mesh_warnings(input.mesh, &mesh, &topo));
     report.times.topology = lap(&clock, 0.0);
 
     let contexts: Vec<PrimitiveContext> = input
