@@ -64,8 +64,8 @@ pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
         Some("gltf") => false,
         _ => {
             return Err(Error::invalid(
-                &shown,
-                "output name must end in .glb or .gltf",
+                "output name",
+                "has no .glb or .gltf extension (expected one of them)",
             ))
         }
     };

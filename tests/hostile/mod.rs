@@ -152,3 +152,88 @@ impl Lcg {
         ((self.0 >> 33) as usize) % n.max(1)
     }
 }
+
+/// A one-mesh glTF over `positions` (and `normals`, when given) and a triangle list, with its
+/// buffer at `uri` (written by the caller) and correct bounds. Returns the JSON and the buffer.
+pub fn mesh_gltf(
+    positions: &[[f32; 3]],
+    normals: Option<&[[f32; 3]]>,
+    indices: &[u32],
+    uri: &str,
+) -> (Value, Vec<u8>) {
+    let mut bin = Vec::new();
+    let mut views = Vec::new();
+    let mut accessors = Vec::new();
+    let mut attributes = serde_json::Map::new();
+    let mut push_vec3 = |name: &str, data: &[[f32; 3]], bin: &mut Vec<u8>| {
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for p in data {
+            for c in 0..3 {
+                lo[c] = lo[c].min(p[c]);
+                hi[c] = hi[c].max(p[c]);
+                bin.extend_from_slice(&p[c].to_le_bytes());
+            }
+        }
+        let offset = bin.len() - 12 * data.len();
+        views.push(serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": 12 * data.len(), "target": 34962}));
+        let mut acc = serde_json::json!({"bufferView": views.len() - 1, "componentType": 5126, "count": data.len(), "type": "VEC3"});
+        if name == "POSITION" {
+            acc["min"] = serde_json::json!(lo);
+            acc["max"] = serde_json::json!(hi);
+        }
+        accessors.push(acc);
+        attributes.insert(name.into(), serde_json::json!(accessors.len() - 1));
+    };
+    push_vec3("POSITION", positions, &mut bin);
+    if let Some(n) = normals {
+        push_vec3("NORMAL", n, &mut bin);
+    }
+    let offset = bin.len();
+    for i in indices {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    views.push(serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": 4 * indices.len(), "target": 34963}));
+    accessors.push(serde_json::json!({"bufferView": views.len() - 1, "componentType": 5125, "count": indices.len(), "type": "SCALAR"}));
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": attributes, "indices": accessors.len() - 1}]}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"uri": uri, "byteLength": bin.len()}],
+    });
+    (json, bin)
+}
+
+/// A closed tetrahedron (4 vertices, 4 triangles wound outward), the smallest closed mesh.
+pub fn tetrahedron() -> (Vec<[f32; 3]>, Vec<u32>) {
+    (
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ],
+        vec![0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3],
+    )
+}
+
+/// Writes a tetrahedron asset `name` into `dir` whose buffer `uri` is `uri`; returns its path.
+/// The buffer's bytes are written to `bin_at` (relative to `dir`) when given.
+pub fn write_tetrahedron(
+    dir: &Path,
+    name: &str,
+    uri: &str,
+    bin_at: Option<&Path>,
+) -> std::path::PathBuf {
+    let (p, i) = tetrahedron();
+    let (json, bin) = mesh_gltf(&p, None, &i, uri);
+    if let Some(at) = bin_at {
+        std::fs::write(dir.join(at), bin).unwrap();
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, serde_json::to_vec_pretty(&json).unwrap()).unwrap();
+    path
+}
