@@ -169,8 +169,12 @@ pub fn mesh_gltf(
         let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
         for p in data {
             for c in 0..3 {
-                lo[c] = lo[c].min(p[c]);
-                hi[c] = hi[c].max(p[c]);
+                // Bounds of the finite values only, so that a test of non-finite data reaches
+                // the data and not its bounds.
+                if p[c].is_finite() {
+                    lo[c] = lo[c].min(p[c]);
+                    hi[c] = hi[c].max(p[c]);
+                }
                 bin.extend_from_slice(&p[c].to_le_bytes());
             }
         }
