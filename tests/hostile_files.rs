@@ -203,7 +203,7 @@ fn outputs_stay_in_the_output_folder_whatever_the_names_inside() {
         if out.ends_with(".gltf") {
             a[2] = os(&target);
         }
-        a.extend(args.iter().map(|s| std::ffi::OsStr::new(s)));
+        a.extend(args.iter().map(std::ffi::OsStr::new));
         let run = g2tess(&a);
         assert_eq!(run.code, Some(0), "{}", run.stderr);
     }
