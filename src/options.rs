@@ -23,8 +23,11 @@ pub const DEFAULT_CREASE_ANGLE: f64 = 60.0;
 pub const DEFAULT_PROFILE: Profile = Profile::C2;
 /// Default surface scheme.
 pub const DEFAULT_SCHEME: Scheme = Scheme::G2;
-/// Default cap on output triangles per input file, so a typo in `level` cannot fill the disk.
-pub const DEFAULT_MAX_OUTPUT_TRIANGLES: u64 = 50_000_000;
+/// Default cap on output triangles per input file, so a typo in `level` cannot fill the disk or
+/// the memory: at the measured peak of about 470 bytes per output triangle (rounded up to
+/// [`crate::pipeline::PEAK_BYTES_PER_OUTPUT_TRIANGLE`]) 20 million triangles need about 10 GiB,
+/// which leaves room for a desktop session and a second job on a 24 GiB machine.
+pub const DEFAULT_MAX_OUTPUT_TRIANGLES: u64 = 20_000_000;
 /// Default: `uri`s may not leave the asset's folder.
 pub const DEFAULT_ALLOW_OUTSIDE_URIS: bool = false;
 /// Default: never overwrite an input file (or a buffer or image file it refers to).

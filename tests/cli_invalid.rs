@@ -1,7 +1,8 @@
 //! Every file in `../shared/fixtures-real/invalid/` is answered by the real binary with a clear
-//! error, exit status 1, no panic and no output file.
+//! error, exit status 1, no panic, no signal and no output file, within a memory limit.
 
 mod corpus;
+mod hostile;
 
 #[test]
 fn every_invalid_asset_is_refused_cleanly() {
@@ -18,18 +19,12 @@ fn every_invalid_asset_is_refused_cleanly() {
     for input in &files {
         let name = input.file_name().unwrap().to_string_lossy().to_string();
         let output = out_dir.path().join(format!("{name}.out.glb"));
-        let run = corpus::g2tess()
-            .arg(input)
-            .arg("-o")
-            .arg(&output)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&run.stderr);
-        assert_eq!(
-            run.status.code(),
-            Some(1),
-            "{name}: exit status; stderr: {stderr}"
+        let run = hostile::run_limited(
+            &[input.as_os_str(), "-o".as_ref(), output.as_os_str()],
+            None,
         );
+        let stderr = &run.stderr;
+        assert_eq!(run.code, Some(1), "{name}: exit status; {run:?}");
         let prefix = format!("g2tess: error: {}: ", input.display());
         assert!(
             stderr.starts_with(&prefix),

@@ -86,8 +86,14 @@ pub struct Args {
     #[arg(long, help_heading = "Output")]
     pub overdraw: bool,
 
-    /// Refuse outputs with more triangles than this per file [default: 50000000]
-    #[arg(long, value_name = "N", help_heading = "Output")]
+    /// Refuse outputs with more triangles than this per file (about 500 bytes of memory each)
+    /// [default: 20000000]
+    #[arg(
+        long,
+        visible_alias = "max-output-triangles",
+        value_name = "N",
+        help_heading = "Output"
+    )]
     pub max_triangles: Option<u64>,
 
     /// Store attributes quantized (KHR_mesh_quantization): positions 14 bits, normals and

@@ -168,7 +168,7 @@ fn write_one(job: &Job, options: &Options) -> Outcome {
     if let Err(e) = create_parent(&job.output) {
         return Outcome::failed(e);
     }
-    match pipeline::process_file(&job.input, &job.output, options) {
+    match pipeline::process_file_guarded(&job.input, &job.output, options) {
         Ok(report) => Outcome {
             report: Some(report),
             ..Outcome::new(Status::Done)
@@ -179,7 +179,10 @@ fn write_one(job: &Job, options: &Options) -> Outcome {
 
 /// Makes the output exactly as a run would, and compares every file it would write with disk.
 fn check_one(job: &Job, options: &Options) -> Outcome {
-    let (report, files) = match pipeline::encode_file(&job.input, &job.output, options) {
+    let encoded = pipeline::guarded(&job.input, || {
+        pipeline::encode_file(&job.input, &job.output, options)
+    });
+    let (report, files) = match encoded {
         Ok(r) => r,
         Err(e) => return Outcome::failed(e.to_string()),
     };

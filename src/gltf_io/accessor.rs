@@ -69,6 +69,18 @@ fn stored_layout(t: Type, csize: usize) -> (usize, usize, usize) {
     (rows, col_padded, cols)
 }
 
+/// The bytes [`read`] allocates for accessor `a` (tightly packed), from its declaration alone;
+/// saturates instead of overflowing, and is 0 for an accessor whose type is invalid.
+pub fn decoded_size(a: &gltf_json::Accessor) -> u64 {
+    match (&a.component_type, &a.type_) {
+        (Checked::Valid(ct), Checked::Valid(ty)) => a
+            .count
+            .0
+            .saturating_mul((component_size(ct.0) * type_components(*ty)) as u64),
+        _ => 0,
+    }
+}
+
 /// Reads accessor `index` of `doc`, applying sparse substitution.
 pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
     let at = format!("accessors[{index}]");

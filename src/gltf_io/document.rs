@@ -14,21 +14,59 @@ use super::error::{Error, Result};
 use super::{glb, meshopt_decode, uri, validate};
 
 /// Bounds and permissions for reading untrusted assets.
+///
+/// Every bound is checked before the memory it protects is allocated, so a file that lies about
+/// its sizes costs no more than its own bytes.
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct ReadOptions {
-    /// Allow `uri`s that leave the asset's folder (`..`, absolute paths, `file:`).
-    /// Default: `false`. Network schemes are refused regardless.
+    /// Allow `uri`s that leave the asset's folder (`..`, absolute paths, `file:`, symbolic links
+    /// that point out of it). Default: `false`. Network schemes are refused regardless.
     pub allow_outside_uris: bool,
     /// Largest file, buffer, or decoded accessor the reader accepts, in bytes.
     /// Default: [`ReadOptions::DEFAULT_MAX_BYTES`] (2 GiB).
     pub max_bytes: u64,
+    /// Largest JSON text (the `.gltf` file or the GLB's JSON chunk), in bytes.
+    /// Default: [`ReadOptions::DEFAULT_MAX_JSON_BYTES`] (64 MiB).
+    pub max_json_bytes: u64,
+    /// Deepest nesting of JSON arrays and objects. Default: [`ReadOptions::DEFAULT_MAX_JSON_DEPTH`].
+    pub max_json_depth: usize,
+    /// Largest decoded `data:` URI, in bytes. Default: [`ReadOptions::DEFAULT_MAX_DATA_URI_BYTES`]
+    /// (32 MiB).
+    pub max_data_uri_bytes: u64,
 }
 
 impl ReadOptions {
     /// Default for [`ReadOptions::max_bytes`]: large enough for any game asset, small enough
     /// that a lying header cannot make the reader allocate the machine's memory.
     pub const DEFAULT_MAX_BYTES: u64 = 2 << 30;
+    /// Default for [`ReadOptions::max_json_bytes`]. Parsed JSON takes several times its text in
+    /// memory (a number of two characters becomes a 32-byte value, and the reader keeps the
+    /// text's tree and its typed model); real assets have JSON of a few MiB at most, and larger
+    /// buffers belong in a `.bin` or a `.glb`.
+    pub const DEFAULT_MAX_JSON_BYTES: u64 = 64 << 20;
+    /// Default for [`ReadOptions::max_json_depth`]: glTF itself nests 6 levels deep; the rest is
+    /// room for `extras` and extensions, and parsing stays far from the stack's end.
+    pub const DEFAULT_MAX_JSON_DEPTH: usize = 64;
+    /// Default for [`ReadOptions::max_data_uri_bytes`]: `data:` URIs cost a third more than
+    /// binary data and are meant for small buffers and images.
+    pub const DEFAULT_MAX_DATA_URI_BYTES: u64 = 32 << 20;
+    /// Data decoded from a file (meshopt views, accessors) may be at most this many times the
+    /// binary data the file actually holds, plus [`ReadOptions::EXPANSION_SLACK`]: counts and
+    /// strides are declared in the JSON, and without a bound relative to the real data a file of
+    /// a few bytes could ask for gigabytes (zero-filled accessors, accessors sharing one view,
+    /// meshopt views that compress zeros).
+    pub const EXPANSION_FACTOR: u64 = 16;
+    /// See [`ReadOptions::EXPANSION_FACTOR`].
+    pub const EXPANSION_SLACK: u64 = 64 << 20;
+
+    /// The most bytes decoding may produce from `binary` bytes of real data.
+    pub fn expansion_budget(&self, binary: u64) -> u64 {
+        binary
+            .saturating_mul(Self::EXPANSION_FACTOR)
+            .saturating_add(Self::EXPANSION_SLACK)
+            .min(self.max_bytes.max(Self::EXPANSION_SLACK))
+    }
 }
 
 impl Default for ReadOptions {
@@ -36,6 +74,9 @@ impl Default for ReadOptions {
         Self {
             allow_outside_uris: false,
             max_bytes: Self::DEFAULT_MAX_BYTES,
+            max_json_bytes: Self::DEFAULT_MAX_JSON_BYTES,
+            max_json_depth: Self::DEFAULT_MAX_JSON_DEPTH,
+            max_data_uri_bytes: Self::DEFAULT_MAX_DATA_URI_BYTES,
         }
     }
 }
@@ -108,6 +149,7 @@ pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> 
     } else {
         (bytes, None)
     };
+    check_json_size(json, opts)?;
     if json.starts_with(&[0xEF, 0xBB, 0xBF]) {
         return Err(Error::invalid(
             "json",
@@ -138,10 +180,57 @@ pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> 
         dequantize: Default::default(),
         filtered: Default::default(),
     };
-    meshopt_decode::decode_views(&mut doc, opts.max_bytes)?;
-    validate::data(&doc, opts.max_bytes)?;
+    let binary: u64 = doc.buffers.iter().map(|b| b.len() as u64).sum();
+    let budget = opts.expansion_budget(binary);
+    meshopt_decode::decode_views(&mut doc, opts.max_bytes, budget)?;
+    validate::data(&doc, opts.max_bytes, budget)?;
     doc.base = serde_json::to_value(&doc.root).map_err(|e| Error::invalid("json", e))?;
     Ok(doc)
+}
+
+/// Refuses JSON text that is too large or nested too deeply, before parsing it (the parser's
+/// own recursion limit would give a message without the bound).
+fn check_json_size(json: &[u8], opts: &ReadOptions) -> Result<()> {
+    if json.len() as u64 > opts.max_json_bytes {
+        return Err(Error::invalid(
+            "json",
+            format!(
+                "is {} bytes (expected at most {}; store large buffers in a .bin or a .glb)",
+                json.len(),
+                opts.max_json_bytes
+            ),
+        ));
+    }
+    let (mut depth, mut in_string, mut escaped) = (0usize, false, false);
+    for (at, &b) in json.iter().enumerate() {
+        if in_string {
+            match b {
+                _ if escaped => escaped = false,
+                b'\\' => escaped = true,
+                b'"' => in_string = false,
+                _ => {}
+            }
+            continue;
+        }
+        match b {
+            b'"' => in_string = true,
+            b'[' | b'{' => {
+                depth += 1;
+                if depth > opts.max_json_depth {
+                    return Err(Error::invalid(
+                        "json",
+                        format!(
+                            "arrays and objects nest deeper than {} levels at byte {at} (expected at most {})",
+                            opts.max_json_depth, opts.max_json_depth
+                        ),
+                    ));
+                }
+            }
+            b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// A copy of `raw` with the properties `gltf-json` requires but the spec leaves optional filled
@@ -256,13 +345,7 @@ fn load_buffers(
         }
         let data = match (&buffer.uri, bin) {
             (Some(u), _) => {
-                let data = uri::load(
-                    u,
-                    &format!("{at}.uri"),
-                    base_dir,
-                    opts.allow_outside_uris,
-                    opts.max_bytes,
-                )?;
+                let data = uri::load(u, &format!("{at}.uri"), base_dir, &uri::Limits::from(opts))?;
                 if u.starts_with("data:") && data.len() as u64 != declared {
                     return Err(Error::invalid(
                         format!("{at}.byteLength"),

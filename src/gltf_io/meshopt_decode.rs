@@ -42,8 +42,10 @@ pub fn only_compressed_views(root: &gltf_json::Root, buffer: usize) -> bool {
 }
 
 /// Decodes every compressed buffer view in place; their uncompressed bytes move to the scratch
-/// buffer, and the views lose the extension.
-pub fn decode_views(doc: &mut Document, max_bytes: u64) -> Result<()> {
+/// buffer, and the views lose the extension. Each view decodes to at most `max_bytes`, all of
+/// them together to at most `budget` (checked before each view is allocated).
+pub fn decode_views(doc: &mut Document, max_bytes: u64, budget: u64) -> Result<()> {
+    let mut decoded = 0u64;
     for view in 0..doc.root.buffer_views.len() {
         let Some(others) = doc.root.buffer_views[view]
             .extensions
@@ -62,6 +64,14 @@ pub fn decode_views(doc: &mut Document, max_bytes: u64) -> Result<()> {
         let ext = ext
             .as_object()
             .ok_or_else(|| Error::invalid(&at, "is not an object"))?;
+        let size = field_u64(ext, "count", &at)?.saturating_mul(field_u64(ext, "byteStride", &at)?);
+        decoded = decoded.saturating_add(size);
+        if decoded > budget {
+            return Err(Error::invalid(
+                &at,
+                format!("compressed views would decode to {decoded} bytes, over the budget of {budget} for this file's data (expected counts that match the data)"),
+            ));
+        }
         let bytes = decode_one(doc, ext, &at, max_bytes)?;
         doc.relocate_view(view, &bytes);
         let v = &mut doc.root.buffer_views[view];

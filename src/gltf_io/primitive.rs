@@ -85,6 +85,18 @@ impl PrimitiveData {
     }
 }
 
+/// A primitive's size as declared, before decoding: see [`Document::primitive_size`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PrimitiveSize {
+    /// Vertices (elements of POSITION).
+    pub vertices: u64,
+    /// Triangles after strips and fans become a list.
+    pub triangles: u64,
+    /// Bytes the decoded arrays take (every component widened to 4 bytes; a generous bound,
+    /// since accessors decode to the size of their declaration).
+    pub decoded_bytes: u64,
+}
+
 fn index_of(v: &Value, at: &str) -> Result<usize> {
     v.as_u64()
         .map(|i| i as usize)
@@ -114,6 +126,48 @@ impl Document {
             }
         }
         out
+    }
+
+    /// What decoding primitive `prim` of mesh `mesh` would give, from the declared counts alone
+    /// (nothing is read), so that callers can refuse work before allocating it.
+    pub fn primitive_size(&self, mesh: usize, prim: usize) -> PrimitiveSize {
+        let Some(json) = self.primitive_json(mesh, prim) else {
+            return PrimitiveSize::default();
+        };
+        let accessor = |v: &Value| v.as_u64().and_then(|i| self.root.accessors.get(i as usize));
+        let elements = |v: &Value| accessor(v).map_or(0, |a| a.count.0);
+        let floats = |obj: Option<&Value>| -> u64 {
+            obj.and_then(Value::as_object)
+                .into_iter()
+                .flat_map(|o| o.values())
+                .filter_map(accessor)
+                .map(|a| accessor::decoded_size(a).saturating_mul(4))
+                .fold(0, u64::saturating_add)
+        };
+        let attributes = json.get("attributes");
+        let vertices = attributes
+            .and_then(|a| a.get("POSITION"))
+            .map_or(0, elements);
+        let list = json.get("indices").map_or(vertices, elements);
+        let triangles = match json.get("mode").and_then(Value::as_u64).unwrap_or(4) {
+            5 | 6 => list.saturating_sub(2),
+            _ => list / 3,
+        };
+        let targets = json
+            .get("targets")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .map(|t| floats(Some(t)))
+            .fold(0, u64::saturating_add);
+        PrimitiveSize {
+            vertices,
+            triangles,
+            decoded_bytes: floats(attributes)
+                .saturating_add(targets)
+                .saturating_add(list.saturating_mul(4))
+                .saturating_add(triangles.saturating_mul(12)),
+        }
     }
 
     /// Decodes primitive `prim` of mesh `mesh`: every attribute, a triangle list, morph targets.

@@ -2,14 +2,37 @@
 //! names percent-decoded and read from the asset's folder.
 //!
 //! It deliberately never touches the network, and by default refuses any `uri` that would leave
-//! the asset's folder (`..`, absolute paths, `file:`), because a model downloaded from anywhere
-//! must not make the tool read arbitrary files.
+//! the asset's folder (`..`, absolute paths, `file:`, a symbolic link inside the folder that
+//! points out of it), because a model downloaded from anywhere must not make the tool read
+//! arbitrary files. Sizes are checked before anything is read or decoded.
 
 use std::path::{Component, Path, PathBuf};
 
 use base64::Engine as _;
 
+use super::document::ReadOptions;
 use super::error::{Error, Result};
+
+/// What [`load`] may read.
+#[derive(Debug, Clone, Copy)]
+pub struct Limits {
+    /// Follow `uri`s out of the asset's folder.
+    pub allow_outside: bool,
+    /// Largest file read, in bytes.
+    pub max_file_bytes: u64,
+    /// Largest decoded `data:` URI, in bytes.
+    pub max_data_bytes: u64,
+}
+
+impl From<&ReadOptions> for Limits {
+    fn from(o: &ReadOptions) -> Self {
+        Self {
+            allow_outside: o.allow_outside_uris,
+            max_file_bytes: o.max_bytes,
+            max_data_bytes: o.max_data_uri_bytes,
+        }
+    }
+}
 
 /// Where a `uri` points, before any bytes are read.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -80,30 +103,64 @@ pub fn resolve(
     Ok(Target::File(base.join(rel)))
 }
 
-/// Reads the bytes `uri` points at, refusing files larger than `max_bytes` before reading them.
-pub fn load(
-    uri: &str,
-    at: &str,
-    base_dir: Option<&Path>,
-    allow_outside: bool,
-    max_bytes: u64,
-) -> Result<Vec<u8>> {
-    match resolve(uri, at, base_dir, allow_outside)? {
+/// Reads the bytes `uri` points at, refusing files and `data:` payloads larger than `limits`
+/// before reading or decoding them, and files that resolve (through symbolic links) outside
+/// `base_dir` unless allowed.
+pub fn load(uri: &str, at: &str, base_dir: Option<&Path>, limits: &Limits) -> Result<Vec<u8>> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        // Base64 holds 3 bytes in 4 characters: bound the payload before decoding it.
+        let estimate = (rest.len() as u64).saturating_mul(3) / 4;
+        if estimate > limits.max_data_bytes {
+            return Err(Error::invalid(
+                at,
+                format!(
+                    "data: uri holds about {estimate} bytes (expected at most {}; store large buffers in a .bin or a .glb)",
+                    limits.max_data_bytes
+                ),
+            ));
+        }
+    }
+    match resolve(uri, at, base_dir, limits.allow_outside)? {
         Target::Data(bytes) => Ok(bytes),
         Target::File(path) => {
             let shown = format!("{at} ({})", path.display());
+            if !limits.allow_outside {
+                if let Some(base) = base_dir {
+                    stays_inside(&path, base, uri, &shown)?;
+                }
+            }
             let len = std::fs::metadata(&path)
                 .map_err(|e| Error::io(&shown, e))?
                 .len();
-            if len > max_bytes {
+            if len > limits.max_file_bytes {
                 return Err(Error::invalid(
                     shown,
-                    format!("file is {len} bytes (expected at most {max_bytes})"),
+                    format!(
+                        "file is {len} bytes (expected at most {})",
+                        limits.max_file_bytes
+                    ),
                 ));
             }
             std::fs::read(&path).map_err(|e| Error::io(shown, e))
         }
     }
+}
+
+/// Refuses `path` when, with every symbolic link followed, it is not inside `base`: a link in the
+/// asset's folder must not make the tool read a file the asset could not name directly.
+fn stays_inside(path: &Path, base: &Path, uri: &str, shown: &str) -> Result<()> {
+    let real = std::fs::canonicalize(path).map_err(|e| Error::io(shown, e))?;
+    let real_base = std::fs::canonicalize(base).map_err(|e| Error::io(shown, e))?;
+    if real.starts_with(&real_base) {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        shown,
+        format!(
+            "uri {uri:?} is a link to {}, outside the asset's folder (expected a file inside it; pass --allow-outside-uris to permit it)",
+            real.display()
+        ),
+    ))
 }
 
 /// Decodes the part of a `data:` URI after the scheme: base64 or percent-encoded payloads.

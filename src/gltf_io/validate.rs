@@ -418,12 +418,23 @@ fn carried_accessors(root: &gltf_json::Root) -> Vec<bool> {
 
 /// Data checks: finite floats, bounds arrays of the right length (and equal to the data where
 /// the accessor is carried through), indices in range, unit normals, valid skin weights.
-pub fn data(doc: &Document, max_bytes: u64) -> Result<()> {
+///
+/// Every accessor is decoded, so their declared sizes together must fit in `budget` (see
+/// [`super::ReadOptions::EXPANSION_FACTOR`]); each is checked before it is allocated.
+pub fn data(doc: &Document, max_bytes: u64, budget: u64) -> Result<()> {
     let root = &doc.root;
     let carried = carried_accessors(root);
     let mut decoded: Vec<Option<Accessor>> = vec![None; root.accessors.len()];
+    let mut total = 0u64;
     for (i, a) in root.accessors.iter().enumerate() {
         let at = format!("accessors[{i}]");
+        total = total.saturating_add(accessor::decoded_size(a));
+        if total > budget {
+            return Err(Error::invalid(
+                format!("{at}.count"),
+                format!("the accessors up to this one decode to {total} bytes, over the budget of {budget} for this file's data (expected counts that match the data)"),
+            ));
+        }
         let acc = accessor::read(doc, i, max_bytes)?;
         if acc.component_type == ComponentType::F32 {
             if let Some(k) = (0..acc.len()).find(|k| !acc.raw(*k).is_finite()) {

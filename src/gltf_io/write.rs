@@ -78,8 +78,8 @@ pub fn encode(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<Files>
         Some("gltf") => false,
         _ => {
             return Err(Error::invalid(
-                &shown,
-                "output name must end in .glb or .gltf",
+                "output name",
+                "has no .glb or .gltf extension (expected one of them)",
             ))
         }
     };
@@ -117,6 +117,21 @@ pub fn encode(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<Files>
         files.push((path.to_path_buf(), text));
         Ok(files)
     }
+}
+
+/// The `.glb` bytes of `doc`, without touching any file: for callers that keep the result in
+/// memory (and for fuzzing the whole per-file job). Images stored as separate files stay
+/// referenced by their `uri`.
+pub fn to_glb_bytes(doc: &Document, compression: Option<Compression>) -> Result<Vec<u8>> {
+    if compression.is_some_and(|c| c.fallback) {
+        return Err(Error::invalid(
+            "output",
+            "a compressed output with a fallback buffer needs a file beside it (expected a path)",
+        ));
+    }
+    let (json, bin, _) = assemble(doc, false, None, compression, None)?;
+    let text = serde_json::to_vec(&json).map_err(|e| Error::invalid("json", e))?;
+    Ok(glb::assemble(&text, &bin))
 }
 
 fn parent_dir(path: &Path) -> &Path {
@@ -538,8 +553,12 @@ fn embed_external_images(
             Err(_) if u.contains("://") => continue,
             Err(e) => return Err(e),
         };
-        let bytes = std::fs::read(&target)
-            .map_err(|e| Error::io(format!("{at} ({})", target.display()), e))?;
+        // Read through the same checks as buffers: size bound, no link out of the folder.
+        let limits = uri::Limits {
+            allow_outside: doc.allow_outside_uris,
+            ..uri::Limits::from(&super::ReadOptions::default())
+        };
+        let bytes = uri::load(&u, &at, doc.base_dir.as_deref(), &limits)?;
         let mime = image
             .get("mimeType")
             .and_then(Value::as_str)

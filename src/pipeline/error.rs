@@ -28,6 +28,14 @@ pub enum Error {
         /// What was asked and what the asset has.
         what: String,
     },
+    /// A bug: processing panicked. Caught by [`super::guarded`].
+    #[error("{}: internal error: {what} (this is a bug in g2tess, not in the file; please report it with the file)", file.display())]
+    Internal {
+        /// The asset being processed.
+        file: PathBuf,
+        /// The panic's message.
+        what: String,
+    },
     /// The work would exceed a resource bound.
     #[error("{}: {what}", file.display())]
     Limit {
@@ -52,6 +60,19 @@ impl Error {
         Error::Limit {
             file: file.to_path_buf(),
             what: what.into(),
+        }
+    }
+
+    /// A caught panic while processing `file`; `payload` is what the panic carried.
+    pub fn internal(file: &Path, payload: &(dyn std::any::Any + Send)) -> Self {
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic without a message".into());
+        Error::Internal {
+            file: file.to_path_buf(),
+            what,
         }
     }
 

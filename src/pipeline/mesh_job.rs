@@ -60,7 +60,6 @@ pub struct MeshOutput {
     pub report: MeshReport,
 }
 
-/// Smooths one mesh at `level`.
 /// A mesh welded and with its h resolved: what every later stage starts from.
 pub(super) struct Resolved {
     /// Each primitive, checked (and with generated normals where it had none).
@@ -93,6 +92,7 @@ pub(super) fn resolve(
     assign_offsets(&mut prepared);
     let (mesh, groups) = join(&prepared);
     let topo = Topology::build(&mesh);
+    warnings.extend(super::checks::mesh_warnings(input.mesh, &mesh, &topo));
     let contexts: Vec<PrimitiveContext> = input
         .primitives
         .iter()

@@ -1,0 +1,273 @@
+//! What is odd about a mesh's geometry, summed up as one warning per kind for the report:
+//! degenerate and sliver triangles, duplicate triangles, unused vertices, normals facing away
+//! from their faces, open, non-manifold and inconsistently wound edges, bow-tie vertices, many
+//! disconnected pieces.
+//!
+//! It only counts: the fallbacks live where the data is used (degenerate and non-manifold edges
+//! act as h = 0 in [`crate::topology`], normals orient the surface, unused vertices are not
+//! written). It deliberately reports one line per kind, with the first few triangles or vertices
+//! as examples, so that a scan of a million bad triangles gives a readable report.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use crate::mesh::TriMesh;
+use crate::topology::{EdgeKind, Topology};
+
+/// Triangles whose smallest angle is below this (in radians, about 0.06°) are slivers: valid,
+/// but their normals and parameterization are numerically fragile.
+const SLIVER_ANGLE: f64 = 1e-3;
+/// Disconnected pieces above this count are worth a warning (debris, or a mesh exported
+/// without welding).
+const MANY_PIECES: usize = 1000;
+/// Examples listed per warning.
+const EXAMPLES: usize = 3;
+
+/// One warning per odd kind of geometry found in `mesh` (the joined triangle primitives of mesh
+/// `index`), each naming the fallback applied.
+pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<String> {
+    let mut out = Vec::new();
+    let degenerate: Vec<usize> = (0..topo.degenerate.len())
+        .filter(|&t| topo.degenerate[t])
+        .collect();
+    say(
+        &mut out,
+        index,
+        degenerate.len(),
+        first(&degenerate),
+        "zero-area triangles",
+        "are kept flat; their edges are not blended",
+    );
+
+    let slivers: Vec<usize> = (0..mesh.triangles.len())
+        .filter(|&t| !topo.degenerate[t] && smallest_angle(mesh, t) < SLIVER_ANGLE)
+        .collect();
+    say(
+        &mut out,
+        index,
+        slivers.len(),
+        first(&slivers),
+        "sliver triangles",
+        "(an angle below 0.06°) are smoothed like the others; their shading may be poor",
+    );
+
+    let mut seen: HashMap<[u32; 3], usize> = HashMap::new();
+    let mut duplicates = Vec::new();
+    for (t, v) in topo.tri_verts.iter().enumerate() {
+        let mut key = v.map(|x| x.0);
+        key.sort_unstable();
+        if key[0] != key[1] && key[1] != key[2] && seen.insert(key, t).is_some() {
+            duplicates.push(t);
+        }
+    }
+    say(
+        &mut out,
+        index,
+        duplicates.len(),
+        first(&duplicates),
+        "duplicate triangles",
+        "(same corners as an earlier one) are kept; their shared edges are not blended",
+    );
+
+    let mut used = vec![false; mesh.positions.len()];
+    for t in &mesh.triangles {
+        for &c in t {
+            used[c as usize] = true;
+        }
+    }
+    let unused: Vec<usize> = (0..used.len()).filter(|&v| !used[v]).collect();
+    say(
+        &mut out,
+        index,
+        unused.len(),
+        first(&unused),
+        "vertices used by no triangle",
+        "are not written",
+    );
+
+    let mut facing_away = Vec::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        if topo.degenerate[t] {
+            continue;
+        }
+        let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+        let face = (b - a).cross(c - a);
+        if tri
+            .iter()
+            .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
+        {
+            facing_away.push(t);
+        }
+    }
+    say(
+        &mut out,
+        index,
+        facing_away.len(),
+        first(&facing_away),
+        "triangles whose normals all face away from their winding",
+        "follow their normals (the surface is oriented by the normals, not the winding)",
+    );
+
+    let count = |kind: EdgeKind| topo.edges.iter().filter(|e| e.kind == kind).count();
+    let boundary = count(EdgeKind::Boundary);
+    if boundary > 0 {
+        out.push(format!(
+            "mesh {index}: {boundary} open boundary edges are not blended (the surface follows the input there)"
+        ));
+    }
+    let non_manifold: Vec<usize> = (0..topo.edges.len())
+        .filter(|&e| topo.edges[e].kind == EdgeKind::NonManifold)
+        .collect();
+    say(
+        &mut out,
+        index,
+        non_manifold.len(),
+        first(&non_manifold),
+        "non-manifold edges (three or more triangles)",
+        "are not blended",
+    );
+
+    let flipped: Vec<usize> = (0..topo.edges.len())
+        .filter(|&e| topo.edges[e].kind == EdgeKind::Interior && same_direction(topo, e))
+        .collect();
+    say(
+        &mut out,
+        index,
+        flipped.len(),
+        first(&flipped),
+        "edges between triangles of opposite winding",
+        "are smoothed as usual (the surface is oriented by the normals, not the winding)",
+    );
+
+    let bow_ties = bow_tie_vertices(topo);
+    say(
+        &mut out,
+        index,
+        bow_ties.len(),
+        first(&bow_ties),
+        "bow-tie vertices (triangle fans that touch only at the vertex)",
+        "are kept; each fan is smoothed on its own",
+    );
+
+    let pieces = pieces(topo);
+    if pieces > MANY_PIECES {
+        out.push(format!(
+            "mesh {index}: {pieces} disconnected pieces; each is smoothed on its own (expected a welded mesh?)"
+        ));
+    }
+    out
+}
+
+/// Adds "mesh i: N things (first: a, b, c) fallback" when there are any.
+fn say(
+    out: &mut Vec<String>,
+    index: usize,
+    count: usize,
+    examples: &[usize],
+    noun: &str,
+    what: &str,
+) {
+    if count > 0 {
+        let list: Vec<String> = examples.iter().map(ToString::to_string).collect();
+        out.push(format!(
+            "mesh {index}: {count} {noun} (first: {}) {what}",
+            list.join(", ")
+        ));
+    }
+}
+
+fn first(v: &[usize]) -> &[usize] {
+    &v[..v.len().min(EXAMPLES)]
+}
+
+fn smallest_angle(mesh: &TriMesh, t: usize) -> f64 {
+    let p: [DVec3; 3] = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
+    (0..3)
+        .map(|k| (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Do both triangles of interior edge `e` run along it in the same direction (one of them is
+/// wound the other way)?
+fn same_direction(topo: &Topology, e: usize) -> bool {
+    let edge = &topo.edges[e];
+    let dir = |(t, k): (crate::topology::TriId, u8)| {
+        let v = topo.tri_verts[t.0 as usize];
+        v[(k as usize + 1) % 3] == edge.verts[0]
+    };
+    dir(edge.tris[0]) == dir(edge.tris[1])
+}
+
+/// Welded vertices whose triangles form more than one fan (connected through edges that contain
+/// the vertex).
+fn bow_tie_vertices(topo: &Topology) -> Vec<usize> {
+    let n = topo.welded_positions.len();
+    let mut tris_of: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (t, v) in topo.tri_verts.iter().enumerate() {
+        for x in v {
+            if !tris_of[x.0 as usize].contains(&(t as u32)) {
+                tris_of[x.0 as usize].push(t as u32);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (v, tris) in tris_of.iter().enumerate() {
+        if tris.len() < 2 {
+            continue;
+        }
+        // Union the triangles around v that share an edge through v.
+        let mut parent: Vec<usize> = (0..tris.len()).collect();
+        fn root(p: &mut [usize], mut i: usize) -> usize {
+            while p[i] != i {
+                p[i] = p[p[i]];
+                i = p[i];
+            }
+            i
+        }
+        for (i, &t) in tris.iter().enumerate() {
+            for &edge in &topo.tri_edges[t as usize] {
+                let e = &topo.edges[edge.0 as usize];
+                if e.verts[0].0 as usize != v && e.verts[1].0 as usize != v {
+                    continue;
+                }
+                for &(u, _) in &e.tris {
+                    if let Some(j) = tris.iter().position(|&x| x == u.0) {
+                        let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                        parent[a] = b;
+                    }
+                }
+            }
+        }
+        let fans = (0..tris.len())
+            .filter(|&i| root(&mut parent, i) == i)
+            .count();
+        if fans > 1 {
+            out.push(v);
+        }
+    }
+    out
+}
+
+/// Connected pieces of triangles (through welded edges).
+fn pieces(topo: &Topology) -> usize {
+    let n = topo.tri_verts.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    for e in &topo.edges {
+        for w in e.tris.windows(2) {
+            let (a, b) = (
+                root(&mut parent, w[0].0 .0 as usize),
+                root(&mut parent, w[1].0 .0 as usize),
+            );
+            parent[a] = b;
+        }
+    }
+    (0..n).filter(|&i| root(&mut parent, i) == i).count()
+}
