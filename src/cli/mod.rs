@@ -44,14 +44,19 @@ pub fn run() -> i32 {
     let mut status = EXIT_OK;
     for (input, output) in args.inputs.iter().zip(&outputs) {
         match g2tess::pipeline::process_file(input, output, &options) {
-            Ok(r) => eprintln!(
-                "g2tess: {} -> {}: {} primitives, {} -> {} triangles",
-                input.display(),
-                output.display(),
-                r.primitives,
-                r.triangles_in,
-                r.triangles_out
-            ),
+            Ok(r) => {
+                eprintln!(
+                    "g2tess: {} -> {}: {} primitives, {} -> {} triangles",
+                    input.display(),
+                    output.display(),
+                    r.primitives,
+                    r.triangles_in,
+                    r.triangles_out
+                );
+                if args.timings {
+                    eprintln!("g2tess: {}: {}", input.display(), r.times);
+                }
+            }
             Err(e) => {
                 eprintln!("g2tess: error: {e}");
                 status = EXIT_SOME_FAILED;

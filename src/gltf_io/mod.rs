@@ -35,6 +35,6 @@ pub mod write;
 pub use document::{read, read_bytes, Document, ReadOptions};
 pub use error::{Error, ErrorKind, Result};
 pub use meshopt_encode::Compression;
-pub use primitive::{replace_primitive, Attribute, PrimitiveData, Values};
+pub use primitive::{replace_primitive, replace_primitive_owned, Attribute, PrimitiveData, Values};
 pub use quantize::{quantize, Quantization};
 pub use write::{fallback_path, write, WriteOptions};

@@ -235,6 +235,17 @@ pub fn replace_primitive(
     prim: usize,
     data: &PrimitiveData,
 ) -> Result<()> {
+    replace_primitive_owned(doc, mesh, prim, data.clone())
+}
+
+/// [`replace_primitive`] taking `data` by value: each array is dropped as soon as it is stored,
+/// so a dense primitive is never held twice.
+pub fn replace_primitive_owned(
+    doc: &mut Document,
+    mesh: usize,
+    prim: usize,
+    data: PrimitiveData,
+) -> Result<()> {
     let at = format!("meshes[{mesh}].primitives[{prim}]");
     let mut json = doc
         .primitive_json(mesh, prim)
@@ -248,25 +259,31 @@ pub fn replace_primitive(
             format!("new index {bad} is not below the vertex count {vertices}"),
         ));
     }
+    if let Some(a) = data.attributes.iter().find(|a| a.count() != vertices) {
+        return Err(Error::invalid(
+            format!("{at}.attributes.{}", a.name),
+            format!("has {} vertices (expected {vertices})", a.count()),
+        ));
+    }
+    let PrimitiveData {
+        attributes: attribute_data,
+        indices: index_data,
+        targets: target_data,
+    } = data;
     let mut attributes = Map::new();
-    for a in &data.attributes {
-        if a.count() != vertices {
-            return Err(Error::invalid(
-                format!("{at}.attributes.{}", a.name),
-                format!("has {} vertices (expected {vertices})", a.count()),
-            ));
-        }
-        attributes.insert(a.name.clone(), json!(push_attribute(doc, a)));
+    for a in attribute_data {
+        attributes.insert(a.name.clone(), json!(push_attribute(doc, &a)));
     }
     let mut targets = Vec::new();
-    for t in &data.targets {
+    for t in target_data {
         let mut obj = Map::new();
         for a in t {
-            obj.insert(a.name.clone(), json!(push_attribute(doc, a)));
+            obj.insert(a.name.clone(), json!(push_attribute(doc, &a)));
         }
         targets.push(Value::Object(obj));
     }
-    let indices = push_indices(doc, &data.indices, vertices);
+    let indices = push_indices(doc, &index_data, vertices);
+    drop(index_data);
     let obj = json
         .as_object_mut()
         .ok_or_else(|| Error::invalid(&at, "is not an object"))?;
@@ -318,11 +335,16 @@ fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
         match &a.values {
             Values::Float(v) => {
                 let (mut lo, mut hi) = (vec![f32::INFINITY; n], vec![f32::NEG_INFINITY; n]);
-                for (k, x) in v.iter().enumerate() {
-                    lo[k % n] = lo[k % n].min(*x);
-                    hi[k % n] = hi[k % n].max(*x);
+                for e in v.chunks_exact(n) {
+                    for (k, x) in e.iter().enumerate() {
+                        lo[k] = lo[k].min(*x);
+                        hi[k] = hi[k].max(*x);
+                    }
                 }
-                let bytes = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+                let mut bytes = Vec::with_capacity(v.len() * 4);
+                for x in v {
+                    bytes.extend_from_slice(&x.to_le_bytes());
+                }
                 (
                     ComponentType::F32,
                     bytes,
@@ -400,10 +422,11 @@ fn push_indices(doc: &mut Document, indices: &[u32], vertices: usize) -> usize {
                 .collect(),
         )
     } else {
-        (
-            ComponentType::U32,
-            indices.iter().flat_map(|i| i.to_le_bytes()).collect(),
-        )
+        let mut bytes = Vec::with_capacity(indices.len() * 4);
+        for i in indices {
+            bytes.extend_from_slice(&i.to_le_bytes());
+        }
+        (ComponentType::U32, bytes)
     };
     let view = doc.push_view(
         &bytes,

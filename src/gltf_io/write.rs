@@ -6,6 +6,7 @@
 //! interrupted run never leaves a half-written output. It deliberately never overwrites the
 //! input (or a file the input refers to) unless asked to.
 
+use std::borrow::Cow;
 use std::collections::BTreeSet;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -92,14 +93,60 @@ pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
     }
     if as_glb {
         let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
-        atomic_write(path, &glb::assemble(&text, &bin))
+        let (head, tail) = glb::frame(&text, bin.len());
+        let mut pieces = vec![&head[..]];
+        pieces.extend(bin.pieces.iter().map(|p| &p[..]));
+        pieces.push(tail);
+        atomic_write_pieces(path, &pieces)
     } else {
         let mut text = serde_json::to_vec_pretty(&json).map_err(|e| Error::invalid(&shown, e))?;
         text.push(b'\n');
         if let Some(bin_path) = bin_path.filter(|_| !bin.is_empty()) {
-            atomic_write(&bin_path, &bin)?;
+            let pieces: Vec<&[u8]> = bin.pieces.iter().map(|p| &p[..]).collect();
+            atomic_write_pieces(&bin_path, &pieces)?;
         }
         atomic_write(path, &text)
+    }
+}
+
+/// The output's binary buffer as the pieces it is made of, most of them borrowed from the
+/// document: the buffer views of a dense mesh are hundreds of megabytes, and concatenating them
+/// before writing would hold them twice.
+#[derive(Debug, Default)]
+struct Bin<'a> {
+    pieces: Vec<Cow<'a, [u8]>>,
+    len: usize,
+}
+
+impl<'a> Bin<'a> {
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    fn push(&mut self, bytes: impl Into<Cow<'a, [u8]>>) {
+        let bytes = bytes.into();
+        self.len += bytes.len();
+        self.pieces.push(bytes);
+    }
+
+    fn align4(&mut self) {
+        let pad = (4 - self.len % 4) % 4;
+        if pad != 0 {
+            self.push(vec![0u8; pad]);
+        }
+    }
+
+    /// One contiguous buffer, for the compressor, which rewrites it.
+    fn concat(self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.len);
+        for p in &self.pieces {
+            out.extend_from_slice(p);
+        }
+        out
     }
 }
 
@@ -164,6 +211,11 @@ fn refuse_overwriting_input(
 
 /// Writes `bytes` to a temporary file in `path`'s folder, then renames it over `path`.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
+    atomic_write_pieces(path, &[bytes])
+}
+
+/// [`atomic_write`] of the concatenation of `pieces`, without concatenating them in memory.
+pub fn atomic_write_pieces(path: &Path, pieces: &[&[u8]]) -> Result<()> {
     let shown = path.display().to_string();
     let mut builder = tempfile::Builder::new();
     builder.prefix(".g2tess-").suffix(".tmp");
@@ -176,7 +228,9 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
     let mut tmp = builder
         .tempfile_in(parent_dir(path))
         .map_err(|e| Error::io(&shown, e))?;
-    tmp.write_all(bytes).map_err(|e| Error::io(&shown, e))?;
+    for bytes in pieces {
+        tmp.write_all(bytes).map_err(|e| Error::io(&shown, e))?;
+    }
     tmp.as_file().sync_all().map_err(|e| Error::io(&shown, e))?;
     tmp.persist(path).map_err(|e| Error::io(&shown, e.error))?;
     Ok(())
@@ -184,13 +238,13 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
 
 /// Builds the output JSON, its binary buffer, and (compressed, when asked) the uncompressed
 /// fallback buffer's bytes.
-fn assemble(
-    doc: &Document,
+fn assemble<'a>(
+    doc: &'a Document,
     embed_images: bool,
     bin_path: Option<&Path>,
     compression: Option<Compression>,
     fallback_path: Option<&Path>,
-) -> Result<(Value, Vec<u8>, Option<Vec<u8>>)> {
+) -> Result<(Value, Bin<'a>, Option<Vec<u8>>)> {
     let now = serde_json::to_value(&doc.root).map_err(|e| Error::invalid("json", e))?;
     let mut out = json_merge::merge(&doc.base, &now, &doc.raw);
     let root = out
@@ -266,7 +320,7 @@ fn assemble(
         .and_then(Value::as_array)
         .cloned()
         .unwrap_or_default();
-    let mut bin = Vec::new();
+    let mut bin = Bin::default();
     let mut views = Vec::new();
     let mut view_map = vec![None; keep_view.len()];
     for (i, keep) in keep_view.iter().enumerate() {
@@ -275,11 +329,11 @@ fn assemble(
         }
         let bytes = doc.view_bytes(i)?;
         let mut v = typed_views[i].clone();
-        align4(&mut bin);
+        bin.align4();
         v["buffer"] = json!(0);
         v["byteOffset"] = json!(bin.len());
         v["byteLength"] = json!(bytes.len());
-        bin.extend_from_slice(bytes);
+        bin.push(bytes);
         view_map[i] = Some(views.len());
         views.push(v);
     }
@@ -325,7 +379,11 @@ fn assemble(
                 .iter()
                 .filter_map(|(v, f)| Some((view_map.get(*v).copied().flatten()?, f.clone())))
                 .collect();
-            meshopt_encode::compress(root, &mut views, &mut bin, &filtered, c.fallback)?
+            let mut flat = std::mem::take(&mut bin).concat();
+            let fallback =
+                meshopt_encode::compress(root, &mut views, &mut flat, &filtered, c.fallback)?;
+            bin.push(flat);
+            fallback
         }
         None => None,
     };
@@ -334,7 +392,7 @@ fn assemble(
     let mut buffers = if bin.is_empty() && fallback.is_none() {
         vec![]
     } else {
-        align4(&mut bin);
+        bin.align4();
         let mut b = json!({ "byteLength": bin.len() });
         if let Some(u) = file_uri(bin_path) {
             b["uri"] = json!(u);
@@ -399,12 +457,6 @@ const URI_ESCAPES: &percent_encoding::AsciiSet = &percent_encoding::CONTROLS
     .add(b'|')
     .add(b'}')
     .add(b':');
-
-fn align4(bin: &mut Vec<u8>) {
-    while bin.len() % 4 != 0 {
-        bin.push(0);
-    }
-}
 
 fn set_array(root: &mut Map<String, Value>, key: &str, items: Vec<Value>) {
     if items.is_empty() {
@@ -508,7 +560,7 @@ fn for_each_view_ref(root: &mut Map<String, Value>, f: &mut dyn FnMut(&mut u64))
 fn embed_external_images(
     doc: &Document,
     root: &mut Map<String, Value>,
-    bin: &mut Vec<u8>,
+    bin: &mut Bin<'_>,
     views: &mut Vec<Value>,
 ) -> Result<()> {
     for (i, image) in arr(root, "images").enumerate() {
@@ -535,9 +587,9 @@ fn embed_external_images(
                     "cannot tell the image's type to embed it (expected png, jpeg, webp or ktx2)",
                 )
             })?;
-        align4(bin);
+        bin.align4();
         views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() }));
-        bin.extend_from_slice(&bytes);
+        bin.push(bytes);
         let obj = image.as_object_mut().expect("images are objects");
         obj.remove("uri");
         obj.insert("bufferView".into(), json!(views.len() - 1));

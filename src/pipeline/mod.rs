@@ -114,8 +114,8 @@ pub fn process_document(
     report.times.decode = decode_s;
     for out in outputs {
         let out = out?;
-        for (prim, data) in &out.primitives {
-            gltf_io::replace_primitive(doc, out.report.mesh, *prim, data)
+        for (prim, data) in out.primitives {
+            gltf_io::replace_primitive_owned(doc, out.report.mesh, prim, data)
                 .map_err(|e| Error::gltf(asset, e))?;
         }
         report.add_mesh(out.report);

@@ -38,6 +38,27 @@ pub struct StageTimes {
     pub total: f64,
 }
 
+/// One line for `--timings`: every stage in pipeline order, then the wall time, in seconds.
+impl std::fmt::Display for StageTimes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let stages = [
+            ("read", self.read),
+            ("decode", self.decode),
+            ("topology", self.topology),
+            ("sharpness", self.sharpness),
+            ("surface", self.surface),
+            ("tessellate", self.tessellate),
+            ("optimize", self.optimize),
+            ("attributes", self.attributes),
+            ("write", self.write),
+        ];
+        for (name, s) in stages {
+            write!(f, "{name} {s:.3} s, ")?;
+        }
+        write!(f, "total {:.3} s", self.total)
+    }
+}
+
 impl StageTimes {
     fn add(&mut self, other: &StageTimes) {
         self.topology += other.topology;

@@ -10,7 +10,7 @@ use glam::DVec3;
 use super::blend::neighbour_map;
 use super::pattern::{PatternCache, PointWeights};
 use super::pn::{central_point, compose, pn_net, Net, B111, NEAR};
-use super::{Profile, Surface, SurfacePoint, H_MAX};
+use super::{lattice_index, Profile, Surface, SurfacePoint, H_MAX};
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeKind, Topology, Warning};
 
@@ -175,6 +175,21 @@ impl Surface for G2Surface {
         let pattern = self.patterns.get(level, self.patches[tri].h, self.profile);
         out.extend(pattern.points.iter().map(|w| self.combine(tri, w)));
     }
+
+    fn evaluate_lattice_points(
+        &self,
+        tri: usize,
+        level: u32,
+        points: &[(u32, u32)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let pattern = self.patterns.get(level, self.patches[tri].h, self.profile);
+        out.extend(
+            points
+                .iter()
+                .map(|&(i, j)| self.combine(tri, &pattern.points[lattice_index(level, i, j)])),
+        );
+    }
 }
 
 /// Plain PN triangles (Vlachos et al. 2001; paper Eq. 1–2): the G² surface with h = 0 on every
@@ -197,6 +212,16 @@ impl Surface for PnSurface {
 
     fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
         self.0.evaluate_lattice(tri, level, out)
+    }
+
+    fn evaluate_lattice_points(
+        &self,
+        tri: usize,
+        level: u32,
+        points: &[(u32, u32)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        self.0.evaluate_lattice_points(tri, level, points, out)
     }
 }
 
