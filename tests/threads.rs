@@ -43,7 +43,10 @@ fn dense(threads: usize) -> Vec<DenseMesh> {
     })
 }
 
-fn bits(d: &[DenseMesh]) -> Vec<(Vec<[u32; 3]>, Vec<[u32; 3]>, Vec<u32>)> {
+/// Positions, normals (as bits) and indices of one dense mesh.
+type Bits = (Vec<[u32; 3]>, Vec<[u32; 3]>, Vec<u32>);
+
+fn bits(d: &[DenseMesh]) -> Vec<Bits> {
     d.iter()
         .map(|d| {
             (

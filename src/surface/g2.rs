@@ -6,6 +6,7 @@
 //! bad edges act as h = 0 and are reported through [`G2Surface::warnings`].
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::blend::neighbour_map;
 use super::pattern::{PatternCache, PointWeights};
@@ -85,15 +86,16 @@ impl G2Surface {
             .collect();
         share_unblended_edge_curves(topo, &h_edge, &mut patches);
 
-        for t in 0..patches.len() {
+        let nets: Vec<Net> = patches.iter().map(|p| p.net).collect();
+        patches.par_iter_mut().enumerate().for_each(|(t, patch)| {
             for k in 0..3 {
-                if patches[t].h[k] > 0.0 {
+                if patch.h[k] > 0.0 {
                     let n = topo.neighbours[t][k].expect("blended edges are interior");
                     let cols = neighbour_map(k, n.slots.map(usize::from));
-                    patches[t].across[k] = compose(&patches[n.tri.0 as usize].net, cols);
+                    patch.across[k] = compose(&nets[n.tri.0 as usize], cols);
                 }
             }
-        }
+        });
 
         G2Surface {
             patches,
