@@ -121,6 +121,9 @@ pub fn smooth_mesh(
     let tess_start = Instant::now();
     let mut dense = tessellate(&mesh, &topo, &params.h, surface.as_ref(), level, &groups);
     report.times.tessellate = tess_start.elapsed().as_secs_f64();
+    // The surface holds about 1 kB per input triangle: free it before the attributes are
+    // carried, when the dense mesh is at its largest.
+    drop(surface);
 
     // The tessellator already emits cache-friendly bands with vertices in first-use order:
     // meshoptimizer's vertex cache pass made both figures worse on its output and took longer
