@@ -6,6 +6,7 @@
 //! component types: the I/O layer decodes to these plain arrays and encodes back.
 
 use crate::tessellate::VertexSource;
+use rayon::prelude::*;
 
 /// How an attribute is carried to new vertices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -63,28 +64,43 @@ pub fn carry(
     sources: &[VertexSource],
 ) -> FloatAttribute {
     let c = attribute.components;
-    let mut values = Vec::with_capacity(sources.len() * c);
-    for source in sources {
-        let corners = tris.corners(source);
-        match rule {
-            Carry::Interpolate => {
-                for comp in 0..c {
-                    // Accumulate in f64 so a value equal at all three corners comes out exact.
-                    let v: f64 = (0..3)
-                        .map(|k| {
-                            f64::from(source.bary[k])
-                                * f64::from(attribute.values[corners[k] * c + comp])
-                        })
-                        .sum();
-                    values.push(v as f32);
+    let mut values = vec![0.0f32; sources.len() * c];
+    if c == 0 {
+        return FloatAttribute {
+            components: c,
+            values,
+        };
+    }
+    // Each output vertex depends on its own source only: chunks run in parallel and the result
+    // does not depend on how they were split.
+    const CHUNK: usize = 8192;
+    values
+        .par_chunks_mut(CHUNK * c)
+        .zip(sources.par_chunks(CHUNK))
+        .for_each(|(out, sources)| {
+            for (out, source) in out.chunks_exact_mut(c).zip(sources) {
+                let corners = tris.corners(source);
+                match rule {
+                    Carry::Interpolate => {
+                        for (comp, o) in out.iter_mut().enumerate() {
+                            // Accumulate in f64 so a value equal at all three corners comes out
+                            // exact.
+                            let v: f64 = (0..3)
+                                .map(|k| {
+                                    f64::from(source.bary[k])
+                                        * f64::from(attribute.values[corners[k] * c + comp])
+                                })
+                                .sum();
+                            *o = v as f32;
+                        }
+                    }
+                    Carry::NearestCorner => {
+                        let k = corners[nearest_corner(source.bary)];
+                        out.copy_from_slice(&attribute.values[k * c..k * c + c]);
+                    }
                 }
             }
-            Carry::NearestCorner => {
-                let k = corners[nearest_corner(source.bary)];
-                values.extend_from_slice(&attribute.values[k * c..k * c + c]);
-            }
-        }
-    }
+        });
     FloatAttribute {
         components: c,
         values,

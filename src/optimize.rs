@@ -45,6 +45,27 @@ pub fn optimize(mesh: &mut DenseMesh, overdraw: bool) -> Vec<u32> {
             meshopt::optimize_overdraw_in_place(&mut mesh.indices, &adapter, 1.05);
         }
     }
+    fetch_order(mesh)
+}
+
+/// Overdraw order (threshold 1.05) for a mesh whose triangles are already in vertex cache
+/// order, as the tessellator emits them, then vertex fetch order. Returns the vertex remap like
+/// [`optimize`].
+pub fn order_for_overdraw(mesh: &mut DenseMesh) -> Vec<u32> {
+    let vertex_count = mesh.positions.len();
+    if mesh.indices.is_empty() || vertex_count == 0 {
+        return (0..vertex_count as u32).collect();
+    }
+    let bytes = meshopt::typed_to_bytes(&mesh.positions);
+    if let Ok(adapter) = VertexDataAdapter::new(bytes, 12, 0) {
+        meshopt::optimize_overdraw_in_place(&mut mesh.indices, &adapter, 1.05);
+    }
+    fetch_order(mesh)
+}
+
+/// Renumbers vertices in order of first use by the index buffer; every stream follows.
+fn fetch_order(mesh: &mut DenseMesh) -> Vec<u32> {
+    let vertex_count = mesh.positions.len();
     let remap = meshopt::optimize_vertex_fetch_remap(&mesh.indices, vertex_count);
     let used = remap.iter().filter(|&&r| r != u32::MAX).count();
     mesh.indices = meshopt::remap_index_buffer(Some(&mesh.indices), vertex_count, &remap);

@@ -78,6 +78,10 @@ pub struct Args {
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub report: Option<PathBuf>,
 
+    /// Print the seconds spent in each stage for every file
+    #[arg(long, help_heading = "Output")]
+    pub timings: bool,
+
     /// Keep the tessellator's triangle and vertex order (skip meshoptimizer's ordering)
     #[arg(long, help_heading = "Output")]
     pub no_optimize: bool,

@@ -97,6 +97,7 @@ pub fn run() -> i32 {
             fail_fast: args.fail_fast,
         },
         verbosity,
+        timings: args.timings,
         report: args.report.clone(),
         summary_always: args.inputs.len() > 1 || args.inputs.iter().any(|i| i.is_dir()),
         status: std::cell::Cell::new(EXIT_OK),
@@ -124,6 +125,7 @@ pub struct Runner<'a> {
     layers: &'a args::Layers,
     settings: RunSettings,
     verbosity: Verbosity,
+    timings: bool,
     report: Option<PathBuf>,
     /// Print the summary line even for a single file.
     summary_always: bool,
@@ -138,7 +140,7 @@ impl Runner<'_> {
         let started = Instant::now();
         let mut configs = DirConfigs::new(self.layers);
         let options: Vec<_> = jobs.iter().map(|j| configs.options(j)).collect();
-        let progress = Progress::new(jobs.len(), self.verbosity);
+        let progress = Progress::new(jobs.len(), self.verbosity, self.timings);
         let outcomes = batch::run(
             jobs,
             &options,

@@ -26,11 +26,13 @@ pub enum Verbosity {
 pub struct Progress {
     bar: Option<ProgressBar>,
     verbosity: Verbosity,
+    /// `--timings`: a line of stage times per file.
+    timings: bool,
 }
 
 impl Progress {
     /// A printer for `total` files: a bar if stderr is a terminal and there is more than one.
-    pub fn new(total: usize, verbosity: Verbosity) -> Progress {
+    pub fn new(total: usize, verbosity: Verbosity, timings: bool) -> Progress {
         let bar = (verbosity != Verbosity::Quiet && total > 1 && std::io::stderr().is_terminal())
             .then(|| {
                 let style = ProgressStyle::with_template(
@@ -42,7 +44,11 @@ impl Progress {
                 bar.enable_steady_tick(Duration::from_millis(120));
                 bar
             });
-        Progress { bar, verbosity }
+        Progress {
+            bar,
+            verbosity,
+            timings,
+        }
     }
 
     /// Prints a line above the bar (or plainly).
@@ -67,6 +73,13 @@ impl Progress {
         }
         if let Some(error) = &outcome.error {
             self.line(&format!("g2tess: error: {error}"));
+        }
+        if let (true, Some(report)) = (self.timings, &outcome.report) {
+            self.line(&format!(
+                "g2tess: {}: {}",
+                job.input.display(),
+                report.times
+            ));
         }
         let quiet_lines = self.bar.is_some() && self.verbosity < Verbosity::Verbose;
         if self.verbosity == Verbosity::Quiet || quiet_lines {

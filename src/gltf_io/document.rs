@@ -433,6 +433,13 @@ impl Document {
         self.root.buffer_views.len() - 1
     }
 
+    /// Makes room for `bytes` more in the scratch buffer, so that storing a dense primitive's
+    /// arrays does not grow it by doubling (each doubling copies everything stored so far).
+    pub(crate) fn reserve_views(&mut self, bytes: usize) {
+        let scratch = self.scratch_buffer();
+        self.buffers[scratch].reserve(bytes);
+    }
+
     /// The in-memory buffer that new views go into, created on first use.
     fn scratch_buffer(&mut self) -> usize {
         const NAME: &str = "g2tess scratch";

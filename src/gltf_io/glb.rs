@@ -119,11 +119,23 @@ pub fn split(bytes: &[u8]) -> Result<Chunks<'_>> {
 
 /// Assembles a GLB file from JSON text and BIN bytes, padding both to 4 bytes as the spec asks.
 pub fn assemble(json: &[u8], bin: &[u8]) -> Vec<u8> {
+    let (head, tail) = frame(json, bin.len());
+    let mut out = Vec::with_capacity(head.len() + bin.len() + tail.len());
+    out.extend_from_slice(&head);
+    out.extend_from_slice(bin);
+    out.extend_from_slice(tail);
+    out
+}
+
+/// What surrounds a binary chunk of `bin_len` bytes in a `.glb`: the header, the JSON chunk and
+/// the binary chunk's header; then the binary chunk's padding. Lets a writer stream the binary
+/// data from where it lies instead of copying it into one buffer first.
+pub fn frame(json: &[u8], bin_len: usize) -> (Vec<u8>, &'static [u8]) {
     let pad = |n: usize| (4 - n % 4) % 4;
     let json_len = json.len() + pad(json.len());
-    let bin_len = bin.len() + pad(bin.len());
-    let total = 12 + 8 + json_len + if bin.is_empty() { 0 } else { 8 + bin_len };
-    let mut out = Vec::with_capacity(total);
+    let bin_padded = bin_len + pad(bin_len);
+    let total = 12 + 8 + json_len + if bin_len == 0 { 0 } else { 8 + bin_padded };
+    let mut out = Vec::with_capacity(12 + 8 + json_len + 8);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&2u32.to_le_bytes());
     out.extend_from_slice(&(total as u32).to_le_bytes());
@@ -131,13 +143,12 @@ pub fn assemble(json: &[u8], bin: &[u8]) -> Vec<u8> {
     out.extend_from_slice(&CHUNK_JSON.to_le_bytes());
     out.extend_from_slice(json);
     out.resize(out.len() + pad(json.len()), b' ');
-    if !bin.is_empty() {
-        out.extend_from_slice(&(bin_len as u32).to_le_bytes());
-        out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
-        out.extend_from_slice(bin);
-        out.resize(out.len() + pad(bin.len()), 0);
+    if bin_len == 0 {
+        return (out, &[]);
     }
-    out
+    out.extend_from_slice(&(bin_padded as u32).to_le_bytes());
+    out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
+    (out, &[0u8; 3][..pad(bin_len)])
 }
 
 #[cfg(test)]

@@ -35,6 +35,8 @@ pub mod write;
 pub use document::{read, read_bytes, Document, ReadOptions};
 pub use error::{Error, ErrorKind, Result};
 pub use meshopt_encode::Compression;
-pub use primitive::{replace_primitive, Attribute, PrimitiveData, PrimitiveSize, Values};
+pub use primitive::{
+    replace_primitive, replace_primitive_owned, Attribute, PrimitiveData, PrimitiveSize, Values,
+};
 pub use quantize::{quantize, Quantization};
 pub use write::{encode, fallback_path, to_glb_bytes, write, Files, WriteOptions};

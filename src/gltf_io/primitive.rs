@@ -6,6 +6,8 @@
 //! extensions, extras) and refuses Draco-compressed primitives rather than reading their
 //! placeholder accessors, which hold zeros.
 
+use std::borrow::Cow;
+
 use gltf_json::accessor::{ComponentType, GenericComponentType, Type};
 use gltf_json::mesh::Mode;
 use gltf_json::validation::{Checked, USize64};
@@ -289,6 +291,17 @@ pub fn replace_primitive(
     prim: usize,
     data: &PrimitiveData,
 ) -> Result<()> {
+    replace_primitive_owned(doc, mesh, prim, data.clone())
+}
+
+/// [`replace_primitive`] taking `data` by value: each array is dropped as soon as it is stored,
+/// so a dense primitive is never held twice.
+pub fn replace_primitive_owned(
+    doc: &mut Document,
+    mesh: usize,
+    prim: usize,
+    data: PrimitiveData,
+) -> Result<()> {
     let at = format!("meshes[{mesh}].primitives[{prim}]");
     let mut json = doc
         .primitive_json(mesh, prim)
@@ -302,25 +315,35 @@ pub fn replace_primitive(
             format!("new index {bad} is not below the vertex count {vertices}"),
         ));
     }
+    if let Some(a) = data.attributes.iter().find(|a| a.count() != vertices) {
+        return Err(Error::invalid(
+            format!("{at}.attributes.{}", a.name),
+            format!("has {} vertices (expected {vertices})", a.count()),
+        ));
+    }
+    let PrimitiveData {
+        attributes: attribute_data,
+        indices: index_data,
+        targets: target_data,
+    } = data;
+    // Every array is at most 4 bytes per component, plus up to 3 bytes of alignment each.
+    let arrays = attribute_data.iter().chain(target_data.iter().flatten());
+    let bytes: usize = arrays.map(|a| 4 * a.values.len() + 3).sum::<usize>() + 4 * index_data.len();
+    doc.reserve_views(bytes);
     let mut attributes = Map::new();
-    for a in &data.attributes {
-        if a.count() != vertices {
-            return Err(Error::invalid(
-                format!("{at}.attributes.{}", a.name),
-                format!("has {} vertices (expected {vertices})", a.count()),
-            ));
-        }
-        attributes.insert(a.name.clone(), json!(push_attribute(doc, a)));
+    for a in attribute_data {
+        attributes.insert(a.name.clone(), json!(push_attribute(doc, &a)));
     }
     let mut targets = Vec::new();
-    for t in &data.targets {
+    for t in target_data {
         let mut obj = Map::new();
         for a in t {
-            obj.insert(a.name.clone(), json!(push_attribute(doc, a)));
+            obj.insert(a.name.clone(), json!(push_attribute(doc, &a)));
         }
         targets.push(Value::Object(obj));
     }
-    let indices = push_indices(doc, &data.indices, vertices);
+    let indices = push_indices(doc, &index_data, vertices);
+    drop(index_data);
     let obj = json
         .as_object_mut()
         .ok_or_else(|| Error::invalid(&at, "is not an object"))?;
@@ -368,49 +391,48 @@ pub(crate) fn collect_accessor_refs(prim: &Value, out: &mut std::collections::BT
 /// Writes one attribute as a new accessor; floats as FLOAT, integers in their original type.
 fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
     let n = a.components.max(1);
-    let (ct, mut bytes, min, max): (ComponentType, Vec<u8>, Vec<Value>, Vec<Value>) =
-        match &a.values {
-            Values::Float(v) => {
-                let (mut lo, mut hi) = (vec![f32::INFINITY; n], vec![f32::NEG_INFINITY; n]);
-                for (k, x) in v.iter().enumerate() {
-                    lo[k % n] = lo[k % n].min(*x);
-                    hi[k % n] = hi[k % n].max(*x);
+    let (ct, mut bytes, min, max): (ComponentType, Cow<'_, [u8]>, Vec<Value>, Vec<Value>) = match &a
+        .values
+    {
+        Values::Float(v) => {
+            let (mut lo, mut hi) = (vec![f32::INFINITY; n], vec![f32::NEG_INFINITY; n]);
+            for e in v.chunks_exact(n) {
+                for (k, x) in e.iter().enumerate() {
+                    lo[k] = lo[k].min(*x);
+                    hi[k] = hi[k].max(*x);
                 }
-                let bytes = v.iter().flat_map(|x| x.to_le_bytes()).collect();
-                (
-                    ComponentType::F32,
-                    bytes,
-                    lo.iter().map(|x| json!(*x)).collect(),
-                    hi.iter().map(|x| json!(*x)).collect(),
-                )
             }
-            Values::Uint(v) => {
-                let ct = match a.component_type {
-                    ComponentType::U8 => ComponentType::U8,
-                    ComponentType::U16 => ComponentType::U16,
-                    _ => ComponentType::U32,
-                };
-                let (mut lo, mut hi) = (vec![u32::MAX; n], vec![0u32; n]);
-                for (k, x) in v.iter().enumerate() {
-                    lo[k % n] = lo[k % n].min(*x);
-                    hi[k % n] = hi[k % n].max(*x);
-                }
-                let bytes = v
-                    .iter()
-                    .flat_map(|x| match ct {
-                        ComponentType::U8 => vec![*x as u8],
-                        ComponentType::U16 => (*x as u16).to_le_bytes().to_vec(),
-                        _ => x.to_le_bytes().to_vec(),
-                    })
-                    .collect();
-                (
-                    ct,
-                    bytes,
-                    lo.iter().map(|x| json!(*x)).collect(),
-                    hi.iter().map(|x| json!(*x)).collect(),
-                )
+            (
+                ComponentType::F32,
+                le_bytes(v),
+                lo.iter().map(|x| json!(*x)).collect(),
+                hi.iter().map(|x| json!(*x)).collect(),
+            )
+        }
+        Values::Uint(v) => {
+            let ct = match a.component_type {
+                ComponentType::U8 => ComponentType::U8,
+                ComponentType::U16 => ComponentType::U16,
+                _ => ComponentType::U32,
+            };
+            let (mut lo, mut hi) = (vec![u32::MAX; n], vec![0u32; n]);
+            for (k, x) in v.iter().enumerate() {
+                lo[k % n] = lo[k % n].min(*x);
+                hi[k % n] = hi[k % n].max(*x);
             }
-        };
+            let bytes = match ct {
+                ComponentType::U8 => v.iter().map(|x| *x as u8).collect(),
+                ComponentType::U16 => v.iter().flat_map(|x| (*x as u16).to_le_bytes()).collect(),
+                _ => le_bytes(v),
+            };
+            (
+                ct,
+                bytes,
+                lo.iter().map(|x| json!(*x)).collect(),
+                hi.iter().map(|x| json!(*x)).collect(),
+            )
+        }
+    };
     // Vertex attribute elements must start on 4-byte boundaries: pad them when they are shorter.
     let elem = n * component_size(ct);
     let stride = elem.div_ceil(4) * 4;
@@ -422,7 +444,8 @@ fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
                     .copied()
                     .chain(std::iter::repeat_n(0, stride - elem))
             })
-            .collect();
+            .collect::<Vec<u8>>()
+            .into();
     }
     let count = a.count();
     let view = doc.push_view(
@@ -445,7 +468,7 @@ fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
 
 /// Writes a triangle list as u16 indices when they fit (65535 is the restart value), else u32.
 fn push_indices(doc: &mut Document, indices: &[u32], vertices: usize) -> usize {
-    let (ct, bytes): (ComponentType, Vec<u8>) = if vertices <= 65535 {
+    let (ct, bytes): (ComponentType, Cow<'_, [u8]>) = if vertices <= 65535 {
         (
             ComponentType::U16,
             indices
@@ -454,10 +477,7 @@ fn push_indices(doc: &mut Document, indices: &[u32], vertices: usize) -> usize {
                 .collect(),
         )
     } else {
-        (
-            ComponentType::U32,
-            indices.iter().flat_map(|i| i.to_le_bytes()).collect(),
-        )
+        (ComponentType::U32, le_bytes(indices))
     };
     let view = doc.push_view(
         &bytes,
@@ -476,6 +496,33 @@ fn push_indices(doc: &mut Document, indices: &[u32], vertices: usize) -> usize {
         bounds.as_ref().map(|b| b.0.clone()),
         bounds.map(|b| b.1),
     )
+}
+
+/// The little-endian bytes of 4-byte numbers: on little-endian machines the numbers' own memory,
+/// uncopied (a dense mesh's arrays are hundreds of megabytes).
+fn le_bytes<T: Copy + ToLeBytes>(values: &[T]) -> Cow<'_, [u8]> {
+    if cfg!(target_endian = "little") {
+        Cow::Borrowed(meshopt::typed_to_bytes(values))
+    } else {
+        Cow::Owned(values.iter().flat_map(|x| x.le()).collect())
+    }
+}
+
+/// `to_le_bytes` of the 4-byte number types written here.
+trait ToLeBytes {
+    fn le(self) -> [u8; 4];
+}
+
+impl ToLeBytes for f32 {
+    fn le(self) -> [u8; 4] {
+        self.to_le_bytes()
+    }
+}
+
+impl ToLeBytes for u32 {
+    fn le(self) -> [u8; 4] {
+        self.to_le_bytes()
+    }
 }
 
 /// Appends an accessor over the whole of `view`; returns its index.

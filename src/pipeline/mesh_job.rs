@@ -156,15 +156,17 @@ pub fn smooth_mesh(
     let tess_start = Instant::now();
     let mut dense = tessellate(&mesh, &topo, &params.h, surface.as_ref(), level, &groups);
     report.times.tessellate = tess_start.elapsed().as_secs_f64();
+    // The surface holds about 1 kB per input triangle: free it before the attributes are
+    // carried, when the dense mesh is at its largest.
+    drop(surface);
 
+    // The tessellator already emits cache-friendly bands with vertices in first-use order:
+    // meshoptimizer's vertex cache pass made both figures worse on its output and took longer
+    // than the tessellation (see `optimize.rs`). Only overdraw ordering remains to do.
     let opt_start = Instant::now();
     let remaps: Vec<Option<Vec<u32>>> = dense
         .iter_mut()
-        .map(|d| {
-            options
-                .optimize
-                .then(|| optimize::optimize(d, options.overdraw))
-        })
+        .map(|d| (options.optimize && options.overdraw).then(|| optimize::order_for_overdraw(d)))
         .collect();
     report.times.optimize = opt_start.elapsed().as_secs_f64();
 
@@ -173,16 +175,16 @@ pub fn smooth_mesh(
     let targets = morph::targets(
         &mesh, &topo, &params.h, &prepared, &groups, level, options, &remaps,
     );
-    for (k, ((prep, d), target)) in prepared.iter().zip(&dense).zip(targets).enumerate() {
-        let data = primitive_out::build(prep, d, groups[k].start as u32, target);
+    for (k, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
         report.primitives.push(PrimitiveReport {
             primitive: input.primitives[k].index,
             triangles_in: prep.data.indices.len() / 3,
             vertices_in: prep.source_vertex_count,
             triangles_out: d.indices.len() / 3,
             vertices_out: d.positions.len(),
-            cache: optimize::cache_figures(d),
+            cache: optimize::cache_figures(&d),
         });
+        let data = primitive_out::build(prep, d, groups[k].start as u32, target);
         primitives.push((input.primitives[k].index, data));
     }
     report.times.attributes = attr_start.elapsed().as_secs_f64();

@@ -140,9 +140,12 @@ fn float_attribute(name: &str, components: usize, values: Vec<f32>) -> Attribute
 
 /// The replacement primitive for `prep`, from its dense mesh `dense` (whose sources refer to
 /// whole-mesh triangle `first_tri` onwards) and its re-evaluated morph targets.
+///
+/// The dense mesh's positions, normals and indices move into the result uncopied: for a dense
+/// mesh they are most of the memory the process holds.
 pub fn build(
     prep: &Prepared,
-    dense: &DenseMesh,
+    mut dense: DenseMesh,
     first_tri: u32,
     targets: Vec<TargetSurface>,
 ) -> PrimitiveData {
@@ -150,18 +153,17 @@ pub fn build(
         triangles: &prep.triangles,
         first_tri,
     };
-    let positions: Vec<f32> = dense.positions.iter().flatten().copied().collect();
-    let normals = corner_exact_normals(prep, dense, tris);
-    let flat_normals: Vec<f32> = normals.iter().flatten().copied().collect();
+    keep_exact_corner_normals(prep, &mut dense, tris);
+    let dense = dense;
+    let normals = &dense.normals;
 
     let mut attributes = Vec::with_capacity(prep.data.attributes.len() + 2);
     let mut skin = Skin::default();
     let mut skin_sets: Vec<(String, String)> = Vec::new();
     for a in &prep.data.attributes {
         match a.name.as_str() {
-            "POSITION" => attributes.push(float_attribute("POSITION", 3, positions.clone())),
-            "NORMAL" => attributes.push(float_attribute("NORMAL", 3, flat_normals.clone())),
-            "TANGENT" => {} // regenerated below
+            "POSITION" | "NORMAL" => {} // moved in last
+            "TANGENT" => {}             // regenerated below
             name if name.starts_with("JOINTS_") => {
                 let set = &name["JOINTS_".len()..];
                 let weights = format!("WEIGHTS_{set}");
@@ -183,17 +185,11 @@ pub fn build(
                         }
                     }
                 }
-                attributes.push(carry_one(a, tris, dense));
+                attributes.push(carry_one(a, tris, &dense));
             }
             name if name.starts_with("WEIGHTS_") && skin_sets_has(prep, name) => {}
-            _ => attributes.push(carry_one(a, tris, dense)),
+            _ => attributes.push(carry_one(a, tris, &dense)),
         }
-    }
-    if prep.data.attribute("NORMAL").is_none() {
-        attributes.insert(
-            1.min(attributes.len()),
-            float_attribute("NORMAL", 3, flat_normals),
-        );
     }
     if !skin_sets.is_empty() {
         let carried = attributes::carry_skin(&skin, tris, &dense.sources);
@@ -228,17 +224,17 @@ pub fn build(
     let uvs = prep.needs_tangents.and_then(uv_of);
     let base_tangents = uvs
         .as_ref()
-        .map(|uv| tangents::generate(&dense.positions, &normals, uv, &dense.indices));
+        .map(|uv| tangents::generate(&dense.positions, normals, uv, &dense.indices));
     let base_tangents = base_tangents.or_else(|| {
         // Tangents without the texture coordinates to regenerate them: carry them and make
         // them perpendicular to the new normals again.
         let input = prep.data.attribute("TANGENT")?;
-        let Values::Float(v) = carry_one(input, tris, dense).values else {
+        let Values::Float(v) = carry_one(input, tris, &dense).values else {
             return None;
         };
         (input.components == 4).then(|| {
             v.chunks_exact(4)
-                .zip(&normals)
+                .zip(normals)
                 .map(|(t, n)| reorthogonalize([t[0], t[1], t[2], t[3]], *n))
                 .collect::<Vec<_>>()
         })
@@ -250,6 +246,32 @@ pub fn build(
             t.iter().flatten().copied().collect(),
         ));
     }
+
+    let targets = prep
+        .data
+        .targets
+        .iter()
+        .zip(targets)
+        .map(|(input, surface)| {
+            target_attributes(
+                input,
+                &surface,
+                &dense,
+                normals,
+                tris,
+                uvs.as_deref(),
+                base_tangents.as_deref(),
+            )
+        })
+        .collect();
+    let DenseMesh {
+        positions,
+        normals,
+        indices,
+        ..
+    } = dense;
+    attributes.push(float_attribute("POSITION", 3, positions.into_flattened()));
+    attributes.push(float_attribute("NORMAL", 3, normals.into_flattened()));
 
     // Attributes keep the input's order (tools and diffs read it); new ones follow.
     let rank = |name: &str| -> usize {
@@ -263,27 +285,9 @@ pub fn build(
         }
     };
     attributes.sort_by_key(|a| rank(&a.name));
-
-    let targets = prep
-        .data
-        .targets
-        .iter()
-        .zip(targets)
-        .map(|(input, surface)| {
-            target_attributes(
-                input,
-                &surface,
-                dense,
-                &normals,
-                tris,
-                uvs.as_deref(),
-                base_tangents.as_deref(),
-            )
-        })
-        .collect();
     PrimitiveData {
         attributes,
-        indices: dense.indices.clone(),
+        indices,
         targets,
     }
 }
@@ -338,34 +342,23 @@ fn carry_one(a: &Attribute, tris: SourceTriangles<'_>, dense: &DenseMesh) -> Att
     }
 }
 
-/// Surface normals, except at the source triangle's corners, where the input's own unit normal
-/// is kept bit for bit.
-fn corner_exact_normals(
-    prep: &Prepared,
-    dense: &DenseMesh,
-    tris: SourceTriangles<'_>,
-) -> Vec<[f32; 3]> {
+/// Replaces the surface normals at the source triangles' corners by the input's own unit
+/// normal, bit for bit.
+fn keep_exact_corner_normals(prep: &Prepared, dense: &mut DenseMesh, tris: SourceTriangles<'_>) {
     let Some(exact) = &prep.exact_normals else {
-        return dense.normals.clone();
+        return;
     };
-    dense
-        .normals
-        .iter()
-        .zip(&dense.sources)
-        .map(|(n, s)| {
-            let Some(c) = s.bary.iter().position(|&b| b == 1.0) else {
-                return *n;
-            };
-            let v = tris.triangles[(s.tri - tris.first_tri) as usize][c] as usize;
-            let e = exact[v];
-            let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-            if (len - 1.0).abs() < 1e-6 {
-                e
-            } else {
-                *n
-            }
-        })
-        .collect()
+    for (n, s) in dense.normals.iter_mut().zip(&dense.sources) {
+        let Some(c) = s.bary.iter().position(|&b| b == 1.0) else {
+            continue;
+        };
+        let v = tris.triangles[(s.tri - tris.first_tri) as usize][c] as usize;
+        let e = exact[v];
+        let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+        if (len - 1.0).abs() < 1e-6 {
+            *n = e;
+        }
+    }
 }
 
 /// One morph target of the output: POSITION and NORMAL deltas from the re-evaluated surface,

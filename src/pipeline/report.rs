@@ -4,6 +4,7 @@
 //! Field names are part of the command line's interface (documented in the README); rename
 //! none without a reason.
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::continuity::angle_deg;
@@ -30,10 +31,30 @@ pub struct StageTimes {
     pub optimize: f64,
     /// Carrying attributes, tangents and morph targets.
     pub attributes: f64,
-    /// Writing the output.
+    /// Storing the new arrays as accessors and writing the output.
     pub write: f64,
     /// The whole file, wall time.
     pub total: f64,
+}
+
+/// One line for `--timings`: every stage in pipeline order, then the wall time, in seconds.
+impl std::fmt::Display for StageTimes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let stages = [
+            ("read", self.read),
+            ("decode", self.decode),
+            ("sharpness", self.sharpness),
+            ("surface", self.surface),
+            ("tessellate", self.tessellate),
+            ("optimize", self.optimize),
+            ("attributes", self.attributes),
+            ("write", self.write),
+        ];
+        for (name, s) in stages {
+            write!(f, "{name} {s:.3} s, ")?;
+        }
+        write!(f, "total {:.3} s", self.total)
+    }
 }
 
 impl StageTimes {
@@ -83,41 +104,52 @@ pub struct EdgeFigures {
 impl EdgeFigures {
     /// Measures `surface` over every edge of `topo` with blend widths `h`.
     pub fn measure(surface: &dyn Surface, topo: &Topology, h: &[f64]) -> EdgeFigures {
-        let mut figures = EdgeFigures::default();
         let mean = crate::continuity::mean_edge_length(topo).max(f64::MIN_POSITIVE);
-        for (e, edge) in topo.edges.iter().enumerate() {
-            if edge.kind != EdgeKind::Interior {
-                figures.open_edges += 1;
-                continue;
-            }
-            let smooth = h.get(e).is_some_and(|&v| v > 0.0);
-            if smooth {
-                figures.smooth_edges += 1;
-            } else {
-                figures.crease_edges += 1;
-            }
-            let (f, k) = (edge.tris[0].0 .0 as usize, edge.tris[0].1 as usize);
-            let Some(n) = topo.neighbours[f][k] else {
-                continue;
-            };
-            let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));
-            for x in [0.25, 0.5, 0.75] {
-                let mut on_edge = [0.0; 3];
-                on_edge[(k + 1) % 3] = 1.0 - x;
-                on_edge[(k + 2) % 3] = x;
-                let a = surface.evaluate(f, on_edge);
-                let b = surface.evaluate(g, map_point(k, slots, on_edge));
-                figures.max_gap = figures
-                    .max_gap
-                    .max((a.position - b.position).length() / mean);
-                if smooth {
-                    figures.max_normal_jump_deg = figures
-                        .max_normal_jump_deg
-                        .max(angle_deg(a.normal, b.normal));
+        // Edges are measured in parallel; sums and maxima do not depend on the order.
+        topo.edges
+            .par_iter()
+            .enumerate()
+            .map(|(e, edge)| {
+                let mut figures = EdgeFigures::default();
+                if edge.kind != EdgeKind::Interior {
+                    figures.open_edges += 1;
+                    return figures;
                 }
-            }
-        }
-        figures
+                let smooth = h.get(e).is_some_and(|&v| v > 0.0);
+                if smooth {
+                    figures.smooth_edges += 1;
+                } else {
+                    figures.crease_edges += 1;
+                }
+                let (f, k) = (edge.tris[0].0 .0 as usize, edge.tris[0].1 as usize);
+                let Some(n) = topo.neighbours[f][k] else {
+                    return figures;
+                };
+                let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));
+                for x in [0.25, 0.5, 0.75] {
+                    let mut on_edge = [0.0; 3];
+                    on_edge[(k + 1) % 3] = 1.0 - x;
+                    on_edge[(k + 2) % 3] = x;
+                    let a = surface.evaluate(f, on_edge);
+                    let b = surface.evaluate(g, map_point(k, slots, on_edge));
+                    figures.max_gap = figures
+                        .max_gap
+                        .max((a.position - b.position).length() / mean);
+                    if smooth {
+                        figures.max_normal_jump_deg = figures
+                            .max_normal_jump_deg
+                            .max(angle_deg(a.normal, b.normal));
+                    }
+                }
+                figures
+            })
+            .reduce(EdgeFigures::default, |a, b| EdgeFigures {
+                smooth_edges: a.smooth_edges + b.smooth_edges,
+                crease_edges: a.crease_edges + b.crease_edges,
+                open_edges: a.open_edges + b.open_edges,
+                max_normal_jump_deg: a.max_normal_jump_deg.max(b.max_normal_jump_deg),
+                max_gap: a.max_gap.max(b.max_gap),
+            })
     }
 }
 

@@ -6,11 +6,12 @@
 //! bad edges act as h = 0 and are reported through [`G2Surface::warnings`].
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::blend::neighbour_map;
 use super::pattern::{PatternCache, PointWeights};
 use super::pn::{central_point, compose, pn_net, Net, B111, NEAR};
-use super::{Profile, Surface, SurfacePoint, H_MAX};
+use super::{lattice_index, Profile, Surface, SurfacePoint, H_MAX};
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeKind, Topology, Warning};
 
@@ -85,15 +86,16 @@ impl G2Surface {
             .collect();
         share_unblended_edge_curves(topo, &h_edge, &mut patches);
 
-        for t in 0..patches.len() {
+        let nets: Vec<Net> = patches.iter().map(|p| p.net).collect();
+        patches.par_iter_mut().enumerate().for_each(|(t, patch)| {
             for k in 0..3 {
-                if patches[t].h[k] > 0.0 {
+                if patch.h[k] > 0.0 {
                     let n = topo.neighbours[t][k].expect("blended edges are interior");
                     let cols = neighbour_map(k, n.slots.map(usize::from));
-                    patches[t].across[k] = compose(&patches[n.tri.0 as usize].net, cols);
+                    patch.across[k] = compose(&nets[n.tri.0 as usize], cols);
                 }
             }
-        }
+        });
 
         G2Surface {
             patches,
@@ -175,6 +177,21 @@ impl Surface for G2Surface {
         let pattern = self.patterns.get(level, self.patches[tri].h, self.profile);
         out.extend(pattern.points.iter().map(|w| self.combine(tri, w)));
     }
+
+    fn evaluate_lattice_points(
+        &self,
+        tri: usize,
+        level: u32,
+        points: &[(u32, u32)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let pattern = self.patterns.get(level, self.patches[tri].h, self.profile);
+        out.extend(
+            points
+                .iter()
+                .map(|&(i, j)| self.combine(tri, &pattern.points[lattice_index(level, i, j)])),
+        );
+    }
 }
 
 /// Plain PN triangles (Vlachos et al. 2001; paper Eq. 1–2): the G² surface with h = 0 on every
@@ -197,6 +214,16 @@ impl Surface for PnSurface {
 
     fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
         self.0.evaluate_lattice(tri, level, out)
+    }
+
+    fn evaluate_lattice_points(
+        &self,
+        tri: usize,
+        level: u32,
+        points: &[(u32, u32)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        self.0.evaluate_lattice_points(tri, level, points, out)
     }
 }
 

@@ -73,6 +73,23 @@ pub trait Surface: Sync {
             }
         }
     }
+
+    /// Some points `(i, j)` of the level-`level` lattice of triangle `tri`, appended to `out` in
+    /// the order given; equal to [`Surface::evaluate`] at [`lattice_bary`] bit for bit. The
+    /// tessellator evaluates each shared edge once with it, from one side.
+    fn evaluate_lattice_points(
+        &self,
+        tri: usize,
+        level: u32,
+        points: &[(u32, u32)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        out.extend(
+            points
+                .iter()
+                .map(|&(i, j)| self.evaluate(tri, lattice_bary(level, i, j))),
+        );
+    }
 }
 
 /// Index of lattice point `(i, j)` of level `n`. Lattice order, used by every module: for `j` in

@@ -156,10 +156,20 @@ fn blossom(net: &Net, [x, y, z]: [[f64; 3]; 3]) -> DVec3 {
 
 /// Slot in [`IJK`] order of the control point with exponents `e`.
 fn slot(e: [usize; 3]) -> usize {
-    IJK.iter()
-        .position(|x| *x == e)
-        .expect("exponents sum to 3")
+    SLOT[e[0]][e[1]] as usize
 }
+
+/// The inverse of [`IJK`], indexed by the first two exponents (the third is 3 minus both):
+/// `compose` looks it up 270 times per net.
+const SLOT: [[u8; 4]; 4] = {
+    let mut table = [[u8::MAX; 4]; 4];
+    let mut m = 0;
+    while m < IJK.len() {
+        table[IJK[m][0]][IJK[m][1]] = m as u8;
+        m += 1;
+    }
+    table
+};
 
 #[cfg(test)]
 mod tests {

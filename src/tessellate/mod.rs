@@ -21,14 +21,28 @@
 //! vertices share output vertices, and where the input split a vertex (a UV seam, a hard edge)
 //! the output is split too, with identical positions. A crease (an interior edge whose `h` is 0)
 //! is also split, because the surface's normal jumps there.
+//!
+//! # Speed
+//!
+//! Everything that depends on the level alone is planned once ([`plan`]); the vertex numbering
+//! of a group is index arithmetic on the input triangles ([`layout`]), so every block of
+//! consecutive source triangles owns a contiguous range of the final vertex and index buffers.
+//! Blocks run in parallel (rayon) and write straight into those ranges: no per-vertex
+//! allocation, no hash map, and the same bytes at any thread count. Triangles come out in
+//! cache-friendly bands and vertices in order of first use, so meshoptimizer's passes have
+//! little left to do (`optimize.rs` measures it).
 
 mod lattice_edges;
+mod layout;
+mod plan;
 
 use crate::mesh::TriMesh;
-use crate::surface::{lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
+use crate::surface::{Surface, SurfacePoint};
 use crate::topology::{EdgeId, Topology};
-use glam::DVec3;
 use lattice_edges::{edge_sample_coords, SampleKind};
+use layout::GroupLayout;
+use plan::LatticePlan;
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// Where an output vertex was sampled: a source triangle (index into the whole mesh) and the
@@ -62,6 +76,10 @@ pub fn output_size(tris: usize, level: u32) -> (u64, u64) {
     (t * n * n, t * ((n + 1) * (n + 2) / 2))
 }
 
+/// Output triangles per parallel block: large enough that a block's setup is noise, small
+/// enough that two threads stay balanced on a few thousand input triangles.
+const BLOCK_TRIANGLES: usize = 16 * 1024;
+
 /// Tessellates `groups` (contiguous triangle ranges of `mesh`, one per output primitive) at
 /// level `level` (≥ 1). `h` is the blend width per welded edge, used only to decide which
 /// interior edges are creases (h = 0) and get split output vertices.
@@ -73,11 +91,21 @@ pub fn tessellate(
     level: u32,
     groups: &[Range<usize>],
 ) -> Vec<DenseMesh> {
-    let n = level.max(1);
-    let edge_positions = shared_edge_positions(mesh, topo, surface, n);
+    let plan = LatticePlan::new(level.max(1));
+    let edge_positions = shared_edge_positions(mesh, topo, surface, plan.n);
     groups
-        .iter()
-        .map(|range| tessellate_group(mesh, topo, h, surface, n, range.clone(), &edge_positions))
+        .par_iter()
+        .map(|range| {
+            tessellate_group(
+                mesh,
+                topo,
+                h,
+                surface,
+                &plan,
+                range.clone(),
+                &edge_positions,
+            )
+        })
         .collect()
 }
 
@@ -88,27 +116,31 @@ fn shared_edge_positions(
     topo: &Topology,
     surface: &dyn Surface,
     n: u32,
-) -> Vec<DVec3> {
+) -> Vec<[f32; 3]> {
     let per_edge = (n - 1) as usize;
-    let mut out = vec![DVec3::ZERO; topo.edges.len() * per_edge];
-    let mut done = vec![false; topo.edges.len()];
-    for tri in 0..mesh.triangles.len() {
-        for k in 0..3 {
-            let e = topo.tri_edges[tri][k];
-            if done[e.0 as usize] {
-                continue;
-            }
-            done[e.0 as usize] = true;
-            let forward = canonical_forward(topo, tri, k);
-            for m in 1..n {
-                let (i, j) = edge_sample_coords(n, k, m);
-                let bary = lattice_bary(n, i, j);
-                let slot = if forward { m } else { n - m };
-                out[e.0 as usize * per_edge + (slot - 1) as usize] =
-                    surface.evaluate(tri, bary).position;
-            }
-        }
+    let mut out = vec![[0.0f32; 3]; topo.edges.len() * per_edge];
+    if per_edge == 0 || mesh.triangles.is_empty() {
+        return out;
     }
+    out.par_chunks_mut(per_edge).enumerate().for_each_init(
+        || (Vec::with_capacity(per_edge), Vec::with_capacity(per_edge)),
+        |(points, values): &mut (Vec<(u32, u32)>, Vec<SurfacePoint>), (e, chunk)| {
+            let edge = &topo.edges[e];
+            let Some(&(tri, k)) = edge.tris.iter().min_by_key(|&&(t, k)| (t.0, k)) else {
+                return;
+            };
+            let (tri, k) = (tri.0 as usize, k as usize);
+            points.clear();
+            points.extend((1..n).map(|m| edge_sample_coords(n, k, m)));
+            values.clear();
+            surface.evaluate_lattice_points(tri, n, points, values);
+            let forward = canonical_forward(topo, tri, k);
+            for (m, p) in (1..n).zip(values.iter()) {
+                let slot = if forward { m } else { n - m };
+                chunk[(slot - 1) as usize] = p.position.as_vec3().to_array();
+            }
+        },
+    );
     out
 }
 
@@ -120,102 +152,46 @@ fn canonical_forward(topo: &Topology, tri: usize, k: usize) -> bool {
     from == edge.verts[0]
 }
 
-/// Lower and higher input vertex index, then the triangle and corner for a crease side (or
-/// `u32::MAX` and 0 where both sides share).
-type InputEdgeKey = (u32, u32, u32, u8);
-
-/// An input edge: the unordered pair of input vertex indices, plus (for creases) the triangle
-/// side it belongs to. Half-edges with the same key share output vertices.
-fn input_edge_key(mesh: &TriMesh, crease: bool, tri: usize, k: usize) -> InputEdgeKey {
-    let t = mesh.triangles[tri];
-    let a = t[(k + 1) % 3];
-    let b = t[(k + 2) % 3];
-    let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
-    if crease {
-        (lo, hi, tri as u32, k as u8)
-    } else {
-        (lo, hi, u32::MAX, 0)
-    }
-}
-
 fn is_crease(topo: &Topology, h: &[f64], e: EdgeId) -> bool {
     h.get(e.0 as usize).is_some_and(|&v| v == 0.0) && topo.edges[e.0 as usize].tris.len() >= 2
 }
 
-const UNSET: u32 = u32::MAX;
+/// One block of consecutive source triangles and the slices of the final buffers it owns.
+struct Block<'a> {
+    /// Triangle offsets within the group.
+    tris: Range<usize>,
+    /// First output vertex of the block.
+    vertex_base: usize,
+    positions: &'a mut [[f32; 3]],
+    normals: &'a mut [[f32; 3]],
+    sources: &'a mut [VertexSource],
+    indices: &'a mut [u32],
+}
+
+/// What every block reads.
+struct Shared<'a> {
+    mesh: &'a TriMesh,
+    topo: &'a Topology,
+    surface: &'a dyn Surface,
+    plan: &'a LatticePlan,
+    layout: &'a GroupLayout,
+    edge_positions: &'a [[f32; 3]],
+    first_tri: usize,
+}
 
 fn tessellate_group(
     mesh: &TriMesh,
     topo: &Topology,
     h: &[f64],
     surface: &dyn Surface,
-    n: u32,
+    plan: &LatticePlan,
     range: Range<usize>,
-    edge_positions: &[DVec3],
+    edge_positions: &[[f32; 3]],
 ) -> DenseMesh {
-    let per_edge = (n - 1) as usize;
-    let tri_count = range.len();
-
-    // Input edges of this group, numbered in first-seen order so numbering is deterministic.
-    let mut keys: Vec<InputEdgeKey> = Vec::with_capacity(tri_count * 3);
-    for tri in range.clone() {
-        for k in 0..3 {
-            let crease = is_crease(topo, h, topo.tri_edges[tri][k]);
-            keys.push(input_edge_key(mesh, crease, tri, k));
-        }
-    }
-    let mut order: Vec<usize> = (0..keys.len()).collect();
-    order.sort_by_key(|&i| (keys[i], i));
-    // input_edge_of[half-edge] = dense id of its input edge, ids in order of first appearance.
-    let mut input_edge_of = vec![0u32; keys.len()];
-    let mut first_of_id: Vec<usize> = Vec::new();
-    let mut run_start = 0;
-    while run_start < order.len() {
-        let mut run_end = run_start + 1;
-        while run_end < order.len() && keys[order[run_end]] == keys[order[run_start]] {
-            run_end += 1;
-        }
-        let id = first_of_id.len() as u32;
-        first_of_id.push(order[run_start]);
-        for &half in &order[run_start..run_end] {
-            input_edge_of[half] = id;
-        }
-        run_start = run_end;
-    }
-    // Renumber ids by first appearance so the output does not depend on the sort.
-    let mut renumber = vec![UNSET; first_of_id.len()];
-    let mut next = 0u32;
-    for id in input_edge_of.iter_mut() {
-        let old = *id as usize;
-        if renumber[old] == UNSET {
-            renumber[old] = next;
-            next += 1;
-        }
-        *id = renumber[old];
-    }
-    let input_edge_count = next as usize;
-
-    // Output vertex layout: corners first (numbered as first referenced), then edge samples,
-    // then interior samples per triangle.
-    let mut corner_out = vec![UNSET; mesh.positions.len()];
-    let mut corner_count = 0u32;
-    for tri in range.clone() {
-        for &v in &mesh.triangles[tri] {
-            if corner_out[v as usize] == UNSET {
-                corner_out[v as usize] = corner_count;
-                corner_count += 1;
-            }
-        }
-    }
-    let edge_base = corner_count as usize;
-    let interior_per_tri = if n >= 3 {
-        ((n - 1) * (n - 2) / 2) as usize
-    } else {
-        0
-    };
-    let interior_base = edge_base + input_edge_count * per_edge;
-    let vertex_count = interior_base + tri_count * interior_per_tri;
-
+    let n = plan.n;
+    let layout = GroupLayout::new(mesh, topo, h, n, plan.interior, range.clone());
+    let vertex_count = layout.vertex_count();
+    let per_tri_indices = 3 * (n * n) as usize;
     let mut out = DenseMesh {
         positions: vec![[0.0; 3]; vertex_count],
         normals: vec![[0.0; 3]; vertex_count],
@@ -226,79 +202,130 @@ fn tessellate_group(
             };
             vertex_count
         ],
-        indices: Vec::with_capacity(tri_count * (n * n) as usize * 3),
+        indices: vec![0; range.len() * per_tri_indices],
     };
-    let mut written = vec![false; vertex_count];
-    let mut lattice: Vec<SurfacePoint> = Vec::with_capacity(lattice_len(n));
-    let mut local = vec![0u32; lattice_len(n)];
 
-    for (offset, tri) in range.clone().enumerate() {
+    // Cut the buffers into per-block slices.
+    let tris_per_block = (BLOCK_TRIANGLES / (n * n) as usize).max(1);
+    let mut blocks = Vec::with_capacity(range.len().div_ceil(tris_per_block));
+    let (mut positions, mut normals, mut sources, mut indices) = (
+        &mut out.positions[..],
+        &mut out.normals[..],
+        &mut out.sources[..],
+        &mut out.indices[..],
+    );
+    for start in (0..range.len()).step_by(tris_per_block) {
+        let end = (start + tris_per_block).min(range.len());
+        let vertex_base = layout.base[start] as usize;
+        let vertices = layout.base[end] as usize - vertex_base;
+        let (p, rest_p) = std::mem::take(&mut positions).split_at_mut(vertices);
+        let (nr, rest_n) = std::mem::take(&mut normals).split_at_mut(vertices);
+        let (s, rest_s) = std::mem::take(&mut sources).split_at_mut(vertices);
+        let (i, rest_i) =
+            std::mem::take(&mut indices).split_at_mut((end - start) * per_tri_indices);
+        (positions, normals, sources, indices) = (rest_p, rest_n, rest_s, rest_i);
+        blocks.push(Block {
+            tris: start..end,
+            vertex_base,
+            positions: p,
+            normals: nr,
+            sources: s,
+            indices: i,
+        });
+    }
+    let shared = Shared {
+        mesh,
+        topo,
+        surface,
+        plan,
+        layout: &layout,
+        edge_positions,
+        first_tri: range.start,
+    };
+    blocks
+        .into_par_iter()
+        .for_each(|block| tessellate_block(&shared, block));
+    out
+}
+
+/// Evaluates and writes the vertices a block owns and all its triangles.
+fn tessellate_block(shared: &Shared<'_>, block: Block<'_>) {
+    let Shared {
+        mesh,
+        topo,
+        surface,
+        plan,
+        layout,
+        edge_positions,
+        first_tri,
+    } = *shared;
+    let n = plan.n;
+    let per_edge = (n - 1) as usize;
+    let per_tri_indices = 3 * (n * n) as usize;
+    let mut lattice: Vec<SurfacePoint> = Vec::with_capacity(plan.kinds.len());
+    let mut local = vec![0u32; plan.kinds.len()];
+    for offset in block.tris.clone() {
+        let tri = first_tri + offset;
+        let corners = mesh.triangles[tri];
+        let owns = layout.owns[offset];
+        let interior_base = layout.base[offset + 1] as usize - plan.interior;
         lattice.clear();
         surface.evaluate_lattice(tri, n, &mut lattice);
-        for j in 0..=n {
-            for i in 0..=(n - j) {
-                let li = lattice_index(n, i, j);
-                let (slot, position) = match SampleKind::of(n, i, j) {
-                    SampleKind::Corner(c) => {
-                        // The vertex's own position, not its welded representative: welding
-                        // equates -0.0 and +0.0, and the input's bits are kept.
-                        let v = mesh.triangles[tri][c];
-                        (corner_out[v as usize] as usize, mesh.positions[v as usize])
-                    }
-                    SampleKind::Edge { k, m } => {
-                        let half = offset * 3 + k;
+        for (li, kind) in plan.kinds.iter().enumerate() {
+            let (slot, owned, position) = match *kind {
+                SampleKind::Corner(c) => {
+                    // The vertex's own position, not its welded representative: welding
+                    // equates -0.0 and +0.0, and the input's bits are kept.
+                    let v = corners[c] as usize;
+                    let position = mesh.positions[v].as_vec3().to_array();
+                    (
+                        layout.corner_slot[3 * offset + c] as usize,
+                        owns & (1 << c) != 0,
+                        position,
+                    )
+                }
+                SampleKind::Edge { k, m } => {
+                    let (a, b) = (corners[(k + 1) % 3], corners[(k + 2) % 3]);
+                    // Slot along the input edge, walked from its lower input index.
+                    let slot_m = if a <= b { m } else { n - m };
+                    let slot = layout.edge_slot[3 * offset + k] as usize + (slot_m - 1) as usize;
+                    let owned = owns & (8 << k) != 0;
+                    let position = if owned {
                         let e = topo.tri_edges[tri][k].0 as usize;
-                        let (a_in, b_in) = {
-                            let t = mesh.triangles[tri];
-                            (t[(k + 1) % 3], t[(k + 2) % 3])
-                        };
-                        // Output slot along the input edge, walked from its lower input index.
-                        let slot_m = if a_in <= b_in { m } else { n - m };
-                        let slot = edge_base
-                            + input_edge_of[half] as usize * per_edge
-                            + (slot_m - 1) as usize;
                         let welded_m = if canonical_forward(topo, tri, k) {
                             m
                         } else {
                             n - m
                         };
-                        (slot, edge_positions[e * per_edge + (welded_m - 1) as usize])
-                    }
-                    SampleKind::Interior { index } => (
-                        interior_base + offset * interior_per_tri + index,
-                        lattice[li].position,
-                    ),
-                };
-                local[li] = slot as u32;
-                if !written[slot] {
-                    written[slot] = true;
-                    let bary = lattice_bary(n, i, j);
-                    out.positions[slot] = position.as_vec3().to_array();
-                    out.normals[slot] = lattice[li].normal.as_vec3().to_array();
-                    out.sources[slot] = VertexSource {
-                        tri: tri as u32,
-                        bary: [bary[0] as f32, bary[1] as f32, bary[2] as f32],
+                        edge_positions[e * per_edge + (welded_m - 1) as usize]
+                    } else {
+                        [0.0; 3]
                     };
+                    (slot, owned, position)
                 }
+                SampleKind::Interior { .. } => (
+                    interior_base + plan.interior_rank[li] as usize,
+                    true,
+                    lattice[li].position.as_vec3().to_array(),
+                ),
+            };
+            local[li] = slot as u32;
+            if owned {
+                let at = slot - block.vertex_base;
+                block.positions[at] = position;
+                block.normals[at] = lattice[li].normal.as_vec3().to_array();
+                block.sources[at] = VertexSource {
+                    tri: tri as u32,
+                    bary: plan.bary[li],
+                };
             }
         }
-        emit_triangles(n, &local, &mut out.indices);
-    }
-    out
-}
-
-/// Appends the `n²` sub-triangles of one lattice, wound like the source triangle.
-fn emit_triangles(n: u32, local: &[u32], indices: &mut Vec<u32>) {
-    for j in 0..n {
-        for i in 0..(n - j) {
-            let a = local[lattice_index(n, i, j)];
-            let b = local[lattice_index(n, i + 1, j)];
-            let c = local[lattice_index(n, i, j + 1)];
-            indices.extend_from_slice(&[a, b, c]);
-            if i + j + 1 < n {
-                let d = local[lattice_index(n, i + 1, j + 1)];
-                indices.extend_from_slice(&[b, d, c]);
-            }
+        let start = (offset - block.tris.start) * per_tri_indices;
+        let out = &mut block.indices[start..start + per_tri_indices];
+        for (dst, t) in out.chunks_exact_mut(3).zip(&plan.triangles) {
+            dst[0] = local[t[0] as usize];
+            dst[1] = local[t[1] as usize];
+            dst[2] = local[t[2] as usize];
         }
     }
 }

@@ -1,0 +1,148 @@
+//! The pipeline's stages on one dense job, each alone: evaluating the surface over every
+//! lattice, tessellating (evaluation, shared edges, layout, triangles), meshoptimizer's vertex
+//! cache pass on the tessellated output (which the pipeline no longer runs: it measured slower
+//! and worse than the tessellator's own order), writing the finished document, and the whole
+//! file from read to write.
+//!
+//! The mesh is a 1 280-triangle geodesic sphere at level 16 (327 680 output triangles): small
+//! enough for criterion's repetitions, large enough that every stage runs in parallel blocks.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use g2tess::gltf_io::{self, ReadOptions, WriteOptions};
+use g2tess::mesh::TriMesh;
+use g2tess::optimize;
+use g2tess::options::Options;
+use g2tess::pipeline::{process_document, process_file};
+use g2tess::surface::{G2Surface, Profile, Surface, SurfacePoint};
+use g2tess::tessellate::tessellate;
+use g2tess::topology::Topology;
+use glam::DVec3;
+use std::collections::HashMap;
+use std::hint::black_box;
+use std::path::Path;
+
+const LEVEL: u32 = 16;
+
+/// The icosahedron split `times` times into four, on the unit sphere, with exact normals.
+fn sphere(times: usize) -> TriMesh {
+    let p = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut positions: Vec<DVec3> = [
+        [-1.0, p, 0.0],
+        [1.0, p, 0.0],
+        [-1.0, -p, 0.0],
+        [1.0, -p, 0.0],
+        [0.0, -1.0, p],
+        [0.0, 1.0, p],
+        [0.0, -1.0, -p],
+        [0.0, 1.0, -p],
+        [p, 0.0, -1.0],
+        [p, 0.0, 1.0],
+        [-p, 0.0, -1.0],
+        [-p, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|v| DVec3::from_array(*v).normalize())
+    .collect();
+    let mut triangles: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..times {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut split = |a: u32, b: u32, positions: &mut Vec<DVec3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let m = (positions[a as usize] + positions[b as usize]).normalize();
+                positions.push(m);
+                positions.len() as u32 - 1
+            })
+        };
+        let mut next = Vec::with_capacity(4 * triangles.len());
+        for [a, b, c] in triangles {
+            let (ab, bc, ca) = (
+                split(a, b, &mut positions),
+                split(b, c, &mut positions),
+                split(c, a, &mut positions),
+            );
+            next.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        triangles = next;
+    }
+    TriMesh {
+        normals: positions.clone(),
+        positions,
+        triangles,
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let mesh = sphere(3);
+    let topo = Topology::build(&mesh);
+    let h = vec![0.212; topo.edges.len()];
+    let surface = G2Surface::new(&mesh, &topo, &h, Profile::C2);
+    let out_tris = (mesh.triangles.len() as u64) * u64::from(LEVEL * LEVEL);
+    let whole = 0..mesh.triangles.len();
+    let all = std::slice::from_ref(&whole);
+
+    let mut g = c.benchmark_group("stages");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(out_tris));
+    g.bench_function("evaluate", |b| {
+        let mut out: Vec<SurfacePoint> = Vec::new();
+        b.iter(|| {
+            for t in 0..mesh.triangles.len() {
+                out.clear();
+                surface.evaluate_lattice(t, LEVEL, &mut out);
+                black_box(&out);
+            }
+        })
+    });
+    g.bench_function("tessellate", |b| {
+        b.iter(|| black_box(tessellate(&mesh, &topo, &h, &surface, LEVEL, all)))
+    });
+    let dense = tessellate(&mesh, &topo, &h, &surface, LEVEL, all).remove(0);
+    g.bench_function("meshopt vertex cache + fetch (not in the pipeline)", |b| {
+        b.iter_batched(
+            || dense.clone(),
+            |mut d| black_box(optimize::optimize(&mut d, false)),
+            criterion::BatchSize::LargeInput,
+        )
+    });
+
+    // Writing and the whole file, on the fixture icosahedron at level 128 (327 680 triangles).
+    let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/icosahedron.glb");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let output = dir.path().join("out.glb");
+    let mut options = Options::default();
+    options.level = 128;
+    let mut doc = gltf_io::read(&input, &ReadOptions::default()).expect("fixture reads");
+    process_document(&mut doc, &input, &options).expect("smooths");
+    g.bench_function("write", |b| {
+        let opts = WriteOptions::new(Some(input.clone()), false);
+        b.iter(|| gltf_io::write(&doc, &output, &opts).expect("writes"))
+    });
+    g.bench_function("whole file", |b| {
+        b.iter(|| process_file(&input, &output, &options).expect("smooths"))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
