@@ -24,8 +24,8 @@
 //!
 //! # Speed
 //!
-//! Everything that depends on the level alone is planned once ([`plan`]); the vertex numbering
-//! of a group is index arithmetic on the input triangles ([`layout`]), so every block of
+//! Everything that depends on the level alone is planned once (`plan.rs`); the vertex numbering
+//! of a group is index arithmetic on the input triangles (`layout.rs`), so every block of
 //! consecutive source triangles owns a contiguous range of the final vertex and index buffers.
 //! Blocks run in parallel (rayon) and write straight into those ranges: no per-vertex
 //! allocation, no hash map, and the same bytes at any thread count. Triangles come out in
