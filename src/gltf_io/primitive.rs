@@ -338,7 +338,7 @@ pub fn replace_primitive_owned(
     for t in target_data {
         let mut obj = Map::new();
         for a in t {
-            obj.insert(a.name.clone(), json!(push_attribute(doc, &a)));
+            obj.insert(a.name.clone(), json!(push_target_attribute(doc, &a)));
         }
         targets.push(Value::Object(obj));
     }
@@ -464,6 +464,84 @@ fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
         bounds.then(|| Value::Array(min)),
         bounds.then(|| Value::Array(max)),
     )
+}
+
+/// Writes a morph target's displacements sparse when that is smaller (most of a dense mesh
+/// often does not move), dense otherwise. A target that moves nothing becomes an accessor
+/// without data, which reads as zeros.
+fn push_target_attribute(doc: &mut Document, a: &Attribute) -> usize {
+    let (Values::Float(v), n) = (&a.values, a.components.max(1)) else {
+        return push_attribute(doc, a);
+    };
+    let count = a.count();
+    let moved: Vec<usize> = (0..count)
+        .filter(|&i| v[i * n..i * n + n].iter().any(|x| *x != 0.0))
+        .collect();
+    let index_size = if count <= usize::from(u16::MAX) { 2 } else { 4 };
+    let sparse_bytes = moved.len() * (index_size + 4 * n);
+    if sparse_bytes >= count * 4 * n {
+        return push_attribute(doc, a);
+    }
+    let (mut lo, mut hi) = (vec![0f32; n], vec![0f32; n]);
+    for &i in &moved {
+        for k in 0..n {
+            lo[k] = lo[k].min(v[i * n + k]);
+            hi[k] = hi[k].max(v[i * n + k]);
+        }
+    }
+    let index = push_accessor(
+        doc,
+        0,
+        count,
+        ComponentType::F32,
+        vector_type(n),
+        false,
+        Some(json!(lo)),
+        Some(json!(hi)),
+    );
+    let accessor = &mut doc.root.accessors[index];
+    accessor.buffer_view = None;
+    if moved.is_empty() {
+        return index;
+    }
+    let (index_type, index_bytes): (ComponentType, Vec<u8>) = if index_size == 2 {
+        let b = moved
+            .iter()
+            .flat_map(|&i| (i as u16).to_le_bytes())
+            .collect();
+        (ComponentType::U16, b)
+    } else {
+        let b = moved
+            .iter()
+            .flat_map(|&i| (i as u32).to_le_bytes())
+            .collect();
+        (ComponentType::U32, b)
+    };
+    let values: Vec<u8> = moved
+        .iter()
+        .flat_map(|&i| v[i * n..i * n + n].iter().flat_map(|x| x.to_le_bytes()))
+        .collect();
+    let indices_view = doc.push_view(&index_bytes, None, None);
+    let values_view = doc.push_view(&values, None, None);
+    doc.root.accessors[index].sparse = Some(gltf_json::accessor::sparse::Sparse {
+        count: USize64(moved.len() as u64),
+        indices: gltf_json::accessor::sparse::Indices {
+            buffer_view: gltf_json::Index::new(indices_view as u32),
+            byte_offset: USize64(0),
+            component_type: Checked::Valid(gltf_json::accessor::IndexComponentType(index_type)),
+            extensions: None,
+            extras: Default::default(),
+        },
+        values: gltf_json::accessor::sparse::Values {
+            buffer_view: gltf_json::Index::new(values_view as u32),
+            byte_offset: USize64(0),
+            extensions: None,
+            extras: Default::default(),
+        },
+        extensions: None,
+        extras: Default::default(),
+    });
+    index
 }
 
 /// Writes a triangle list as u16 indices when they fit (65535 is the restart value), else u32.
