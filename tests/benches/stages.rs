@@ -16,80 +16,17 @@ use g2tess::pipeline::{process_document, process_file};
 use g2tess::surface::{G2Surface, Profile, Surface, SurfacePoint};
 use g2tess::tessellate::tessellate;
 use g2tess::topology::Topology;
-use glam::DVec3;
-use std::collections::HashMap;
 use std::hint::black_box;
 use std::path::Path;
+
+#[path = "../support/mod.rs"]
+mod support;
 
 const LEVEL: u32 = 16;
 
 /// The icosahedron split `times` times into four, on the unit sphere, with exact normals.
 fn sphere(times: usize) -> TriMesh {
-    let p = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut positions: Vec<DVec3> = [
-        [-1.0, p, 0.0],
-        [1.0, p, 0.0],
-        [-1.0, -p, 0.0],
-        [1.0, -p, 0.0],
-        [0.0, -1.0, p],
-        [0.0, 1.0, p],
-        [0.0, -1.0, -p],
-        [0.0, 1.0, -p],
-        [p, 0.0, -1.0],
-        [p, 0.0, 1.0],
-        [-p, 0.0, -1.0],
-        [-p, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|v| DVec3::from_array(*v).normalize())
-    .collect();
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..times {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut split = |a: u32, b: u32, positions: &mut Vec<DVec3>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let m = (positions[a as usize] + positions[b as usize]).normalize();
-                positions.push(m);
-                positions.len() as u32 - 1
-            })
-        };
-        let mut next = Vec::with_capacity(4 * triangles.len());
-        for [a, b, c] in triangles {
-            let (ab, bc, ca) = (
-                split(a, b, &mut positions),
-                split(b, c, &mut positions),
-                split(c, a, &mut positions),
-            );
-            next.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
-        }
-        triangles = next;
-    }
-    TriMesh {
-        normals: positions.clone(),
-        positions,
-        triangles,
-    }
+    (0..times).fold(support::icosahedron(), |m, _| support::subdivide(&m))
 }
 
 fn bench(c: &mut Criterion) {
