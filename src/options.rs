@@ -35,8 +35,6 @@ pub const DEFAULT_OVERWRITE_INPUT: bool = false;
 /// Default: hard edges of the input (split normals) are not forced sharp: the surface closes
 /// them smoothly unless the crease-angle rule or an explicit h makes them creases.
 pub const DEFAULT_KEEP_HARD_EDGES: bool = false;
-/// Default: reorder output for the GPU's vertex cache and vertex fetch (meshoptimizer).
-pub const DEFAULT_OPTIMIZE: bool = true;
 /// Default: no overdraw ordering (it costs time and helps only some materials).
 pub const DEFAULT_OVERDRAW: bool = false;
 /// Default Coons shape parameter λ (seed 002), in [0.05, 0.95].
@@ -79,9 +77,7 @@ pub struct Options {
     pub coons_fair: bool,
     /// Give hard edges of the input h = 0. Default: [`DEFAULT_KEEP_HARD_EDGES`].
     pub keep_hard_edges: bool,
-    /// Vertex cache and fetch ordering. Default: [`DEFAULT_OPTIMIZE`].
-    pub optimize: bool,
-    /// Overdraw ordering (after the cache ordering). Default: [`DEFAULT_OVERDRAW`].
+    /// meshoptimizer overdraw ordering, then vertex fetch order. Default: [`DEFAULT_OVERDRAW`].
     pub overdraw: bool,
     /// A sidecar to use instead of `<asset>.g2tess.toml` beside each asset. Default: none.
     pub sidecar: Option<std::path::PathBuf>,
@@ -108,7 +104,6 @@ impl Default for Options {
             coons_lambda: DEFAULT_COONS_LAMBDA,
             coons_fair: DEFAULT_COONS_FAIR,
             keep_hard_edges: DEFAULT_KEEP_HARD_EDGES,
-            optimize: DEFAULT_OPTIMIZE,
             overdraw: DEFAULT_OVERDRAW,
             sidecar: None,
             quantize: DEFAULT_QUANTIZE,
@@ -134,7 +129,6 @@ pub struct ConfigFile {
     pub coons_lambda: Option<f64>,
     pub coons_fair: Option<bool>,
     pub keep_hard_edges: Option<bool>,
-    pub optimize: Option<bool>,
     pub overdraw: Option<bool>,
     pub quantize: Option<bool>,
     pub compress: Option<bool>,
@@ -182,7 +176,6 @@ impl Options {
             coons_lambda,
             coons_fair,
             keep_hard_edges,
-            optimize,
             overdraw,
             quantize,
             compress,

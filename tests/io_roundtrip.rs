@@ -307,7 +307,6 @@ fn every_valid_asset_round_trips_without_loss() {
     let mut opts = Options::default();
     opts.level = 1;
     opts.h = 0.0;
-    opts.optimize = false;
     let mut inputs_written: Vec<(PathBuf, Vec<PathBuf>)> = Vec::new();
     for (n, input) in corpus::gltf_files(&corpus.join("valid")).iter().enumerate() {
         let name = input.strip_prefix(&corpus).unwrap().display().to_string();

@@ -82,11 +82,7 @@ pub struct Args {
     #[arg(long, help_heading = "Output")]
     pub timings: bool,
 
-    /// Keep the tessellator's triangle and vertex order (skip meshoptimizer's ordering)
-    #[arg(long, help_heading = "Output")]
-    pub no_optimize: bool,
-
-    /// Also order triangles to reduce overdraw
+    /// Order triangles to reduce overdraw (meshoptimizer; the tessellator's own order is already cache-friendly)
     #[arg(long, help_heading = "Output")]
     pub overdraw: bool,
 
@@ -243,7 +239,6 @@ impl Args {
             coons_fair: self.coons_fair.then_some(true),
             overwrite_input: self.overwrite_input.then_some(true),
             keep_hard_edges: self.keep_hard_edges.then_some(true),
-            optimize: self.no_optimize.then_some(false),
             overdraw: self.overdraw.then_some(true),
             quantize: self.quantize.then_some(true),
             compress: self.compress.then_some(true),

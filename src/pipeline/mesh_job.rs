@@ -166,7 +166,7 @@ pub fn smooth_mesh(
     let opt_start = Instant::now();
     let remaps: Vec<Option<Vec<u32>>> = dense
         .iter_mut()
-        .map(|d| (options.optimize && options.overdraw).then(|| optimize::order_for_overdraw(d)))
+        .map(|d| options.overdraw.then(|| optimize::order_for_overdraw(d)))
         .collect();
     report.times.optimize = opt_start.elapsed().as_secs_f64();
 

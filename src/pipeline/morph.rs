@@ -29,7 +29,7 @@ pub struct TargetSurface {
 
 /// Per primitive, per target: the morphed surface at that primitive's output vertices.
 ///
-/// `remaps` are the vertex orders [`crate::optimize::optimize`] gave each primitive (`None`
+/// `remaps` are the vertex orders [`crate::optimize::order_for_overdraw`] gave each primitive (`None`
 /// where it did not run).
 #[allow(clippy::too_many_arguments)]
 pub fn targets(
