@@ -51,17 +51,7 @@ impl G2Surface {
     /// # Panics
     /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
     pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64], profile: Profile) -> Self {
-        assert_eq!(h_per_edge.len(), topo.edges.len(), "one h per welded edge");
-        assert_eq!(
-            topo.tri_verts.len(),
-            mesh.triangles.len(),
-            "topology of this mesh"
-        );
-        assert_eq!(
-            mesh.normals.len(),
-            mesh.positions.len(),
-            "one normal per vertex"
-        );
+        super::assert_belong_together(mesh, topo, h_per_edge);
 
         let (h_edge, warnings) = effective_widths(topo, h_per_edge);
         let mut patches: Vec<Patch> = mesh

@@ -38,6 +38,9 @@ pub mod scheme;
 
 use glam::DVec3;
 
+use crate::mesh::TriMesh;
+use crate::topology::Topology;
+
 pub use g2::{G2Surface, PnSurface};
 pub use profile::Profile;
 pub use scheme::{build_surface, Scheme, SchemeParams};
@@ -46,6 +49,26 @@ pub use scheme::{build_surface, Scheme, SchemeParams};
 /// of a triangle just touch (notes item 4). `h` is a length in the paper's reference triangle
 /// (equilateral, side √2), not in world units.
 pub const H_MAX: f64 = std::f64::consts::SQRT_2 / 4.0;
+
+/// Checks that a mesh, its topology and its per-edge widths belong together; every surface's
+/// constructor calls it, since a mismatch is a caller bug that would otherwise index out of
+/// bounds far from its cause.
+///
+/// # Panics
+/// If `topo` was not built from `mesh`, or `h_per_edge` is not one value per welded edge.
+pub(crate) fn assert_belong_together(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64]) {
+    assert_eq!(h_per_edge.len(), topo.edges.len(), "one h per welded edge");
+    assert_eq!(
+        topo.tri_verts.len(),
+        mesh.triangles.len(),
+        "topology of this mesh"
+    );
+    assert_eq!(
+        mesh.normals.len(),
+        mesh.positions.len(),
+        "one normal per vertex"
+    );
+}
 
 /// A point of a surface with its unit normal.
 #[derive(Debug, Clone, Copy, PartialEq)]

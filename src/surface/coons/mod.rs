@@ -103,16 +103,7 @@ impl CoonsSurface {
     /// # Panics
     /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
     pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64], params: &SchemeParams) -> Self {
-        assert_eq!(
-            topo.tri_verts.len(),
-            mesh.triangles.len(),
-            "topology of this mesh"
-        );
-        assert_eq!(
-            mesh.normals.len(),
-            mesh.positions.len(),
-            "one normal per vertex"
-        );
+        super::assert_belong_together(mesh, topo, h_per_edge);
         let (corners, nets, smooth, warnings) = match params.constituents {
             Constituents::PnAverage => pn_average(mesh, topo, h_per_edge),
             Constituents::FoleyOpitz => {

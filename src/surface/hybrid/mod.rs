@@ -73,16 +73,7 @@ impl EdgeNets {
     /// # Panics
     /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
     pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64], reading: PaperReading) -> Self {
-        assert_eq!(
-            topo.tri_verts.len(),
-            mesh.triangles.len(),
-            "topology of this mesh"
-        );
-        assert_eq!(
-            mesh.normals.len(),
-            mesh.positions.len(),
-            "one normal per vertex"
-        );
+        super::assert_belong_together(mesh, topo, h_per_edge);
         let corners: Vec<Corners> = (0..mesh.triangles.len())
             .map(|t| Corners::of(mesh, t))
             .collect();
