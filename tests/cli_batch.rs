@@ -304,6 +304,33 @@ fn check_passes_on_current_outputs_and_fails_on_stale_or_missing_ones() {
 }
 
 #[test]
+fn check_compares_a_compressed_outputs_fallback_buffer_and_never_writes_it() {
+    let dir = corpus::temp_dir();
+    let tree = dir.path().join("tree");
+    std::fs::create_dir_all(&tree).unwrap();
+    std::fs::copy(example(), tree.join("a.glb")).unwrap();
+    let out = dir.path().join("out");
+    let flags = ["--level", "2", "--compress", "--compress-fallback"];
+    let (made, _) = run(&tree, &out, &flags);
+    assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
+    let fallback = out.join("a.fallback.bin");
+    assert!(fallback.is_file(), "no fallback buffer written");
+    let (ok, _) = run(&tree, &out, &[&flags[..], &["--check"]].concat());
+    assert_eq!(ok.status.code(), Some(0), "{}", stderr(&ok));
+
+    std::fs::remove_file(&fallback).unwrap();
+    let (missing, report) = run(&tree, &out, &[&flags[..], &["--check"]].concat());
+    assert_eq!(missing.status.code(), Some(1));
+    assert_eq!(record(&report, "a.glb")["status"], "changed");
+    assert!(
+        stderr(&missing).contains(&format!("{}: missing", fallback.display())),
+        "{}",
+        stderr(&missing)
+    );
+    assert!(!fallback.exists(), "--check wrote the fallback buffer");
+}
+
+#[test]
 fn outputs_are_byte_equal_at_any_thread_count() {
     let dir = corpus::temp_dir();
     let tree = tree(dir.path());

@@ -186,12 +186,14 @@ fn check_one(job: &Job, options: &Options) -> Outcome {
         Ok(r) => r,
         Err(e) => return Outcome::failed(e.to_string()),
     };
-    let stale = files
-        .iter()
-        .find(|(file, bytes)| std::fs::read(file).ok().as_deref() != Some(bytes.as_slice()));
+    let stale = files.iter().find(|f| {
+        !std::fs::read(&f.path)
+            .ok()
+            .is_some_and(|on_disk| f.same_as(&on_disk))
+    });
     let (status, error) = match stale {
         None => (Status::Unchanged, None),
-        Some((file, _)) => (
+        Some(g2tess::gltf_io::OutputFile { path: file, .. }) => (
             Status::Changed,
             Some(format!(
                 "{}: {} (expected what {} gives now; run without --check to update it)",

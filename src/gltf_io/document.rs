@@ -6,10 +6,12 @@
 //! error (see [`super::validate`]).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use gltf_json::validation::{USize64, Validate};
 use serde_json::Value;
 
+use super::buffer_data::{BufferData, Piece};
 use super::error::{Error, Result};
 use super::{glb, meshopt_decode, uri, validate};
 
@@ -91,8 +93,9 @@ pub struct Document {
     pub(crate) raw: Value,
     /// `root` serialized right after reading: what "unchanged" looks like in typed form.
     pub(crate) base: Value,
-    /// The bytes of each entry of `root.buffers` (a meshopt fallback buffer holds none).
-    pub(crate) buffers: Vec<Vec<u8>>,
+    /// The bytes of each entry of `root.buffers` (a meshopt fallback buffer holds none), shared
+    /// with the output being written (see [`super::buffer_data`]).
+    pub(crate) buffers: Vec<Arc<BufferData>>,
     /// Primitives replaced since reading, as JSON (key: mesh, primitive).
     pub(crate) replaced: std::collections::BTreeMap<(usize, usize), Value>,
     /// The accessors the replaced primitives referenced when read.
@@ -171,7 +174,10 @@ pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> 
         base: Value::Null,
         root,
         raw,
-        buffers,
+        buffers: buffers
+            .into_iter()
+            .map(|b| Arc::new(BufferData::Bytes(b)))
+            .collect(),
         replaced: Default::default(),
         replaced_accessors: Default::default(),
         base_dir: base_dir.map(Path::to_path_buf),
@@ -180,7 +186,7 @@ pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> 
         dequantize: Default::default(),
         filtered: Default::default(),
     };
-    let binary: u64 = doc.buffers.iter().map(|b| b.len() as u64).sum();
+    let binary = doc.buffer_bytes();
     let budget = opts.expansion_budget(binary);
     meshopt_decode::decode_views(&mut doc, opts.max_bytes, budget)?;
     validate::data(&doc, opts.max_bytes, budget)?;
@@ -386,6 +392,20 @@ fn load_buffers(
 impl Document {
     /// The bytes of buffer view `view`, bounds already checked at read time.
     pub(crate) fn view_bytes(&self, view: usize) -> Result<&[u8]> {
+        let (data, range) = self.view_range(view)?;
+        Ok(&data.as_bytes()[range])
+    }
+
+    /// Buffer view `view` as a piece of an output file, sharing the document's memory.
+    pub(crate) fn view_piece(&self, view: usize) -> Result<Piece> {
+        let (data, range) = self.view_range(view)?;
+        Ok(Piece::Shared {
+            data: Arc::clone(data),
+            range,
+        })
+    }
+
+    fn view_range(&self, view: usize) -> Result<(&Arc<BufferData>, std::ops::Range<usize>)> {
         let v = self
             .root
             .buffer_views
@@ -394,15 +414,52 @@ impl Document {
         let data = &self.buffers[v.buffer.value()];
         let start = v.byte_offset.map_or(0, |o| o.0) as usize;
         let end = start + v.byte_length.0 as usize;
-        data.get(start..end).ok_or_else(|| {
-            Error::invalid(
+        if end > data.len() {
+            return Err(Error::invalid(
                 format!("bufferViews[{view}]"),
                 format!(
                     "bytes {start}..{end} are not in its buffer of {} bytes",
                     data.len()
                 ),
-            )
-        })
+            ));
+        }
+        Ok((data, start..end))
+    }
+
+    /// Bytes held in all buffers.
+    pub(crate) fn buffer_bytes(&self) -> u64 {
+        self.buffers.iter().map(|b| b.len() as u64).sum()
+    }
+
+    /// Stores `data` (a whole array the pipeline made) as a buffer of its own, uncopied, and a
+    /// buffer view over all of it; returns the view's index. The writer packs every view into
+    /// one output buffer, so the number of in-memory buffers never shows in the output.
+    pub(crate) fn push_array_view(
+        &mut self,
+        data: BufferData,
+        stride: Option<usize>,
+        target: Option<gltf_json::buffer::Target>,
+    ) -> usize {
+        let len = data.len();
+        self.root.buffers.push(gltf_json::Buffer {
+            byte_length: USize64(len as u64),
+            name: Some("g2tess array".into()),
+            uri: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.buffers.push(Arc::new(data));
+        self.root.buffer_views.push(gltf_json::buffer::View {
+            buffer: gltf_json::Index::new((self.buffers.len() - 1) as u32),
+            byte_length: USize64(len as u64),
+            byte_offset: Some(USize64(0)),
+            byte_stride: stride.map(gltf_json::buffer::Stride),
+            name: None,
+            target: target.map(gltf_json::validation::Checked::Valid),
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.root.buffer_views.len() - 1
     }
 
     /// Appends `bytes` as a new buffer view in the document's scratch buffer; returns its index.
@@ -413,7 +470,7 @@ impl Document {
         target: Option<gltf_json::buffer::Target>,
     ) -> usize {
         let scratch = self.scratch_buffer();
-        let data = &mut self.buffers[scratch];
+        let data = Arc::make_mut(&mut self.buffers[scratch]).bytes_mut();
         while data.len() % 4 != 0 {
             data.push(0);
         }
@@ -431,13 +488,6 @@ impl Document {
             extras: Default::default(),
         });
         self.root.buffer_views.len() - 1
-    }
-
-    /// Makes room for `bytes` more in the scratch buffer, so that storing a dense primitive's
-    /// arrays does not grow it by doubling (each doubling copies everything stored so far).
-    pub(crate) fn reserve_views(&mut self, bytes: usize) {
-        let scratch = self.scratch_buffer();
-        self.buffers[scratch].reserve(bytes);
     }
 
     /// The in-memory buffer that new views go into, created on first use.
@@ -458,14 +508,14 @@ impl Document {
             extensions: None,
             extras: Default::default(),
         });
-        self.buffers.push(Vec::new());
+        self.buffers.push(Arc::default());
         self.buffers.len() - 1
     }
 
     /// Points buffer view `view` at `bytes` (decoded meshopt data) in the scratch buffer.
     pub(crate) fn relocate_view(&mut self, view: usize, bytes: &[u8]) {
         let scratch = self.scratch_buffer();
-        let data = &mut self.buffers[scratch];
+        let data = Arc::make_mut(&mut self.buffers[scratch]).bytes_mut();
         while data.len() % 4 != 0 {
             data.push(0);
         }

@@ -107,12 +107,16 @@ fn decode_one(
     let count = field_u64(ext, "count", at)?;
     let mode = ext.get("mode").and_then(Value::as_str).unwrap_or("");
     let filter = ext.get("filter").and_then(Value::as_str).unwrap_or("NONE");
-    let data = doc.buffers.get(buffer).ok_or_else(|| {
-        Error::invalid(
-            format!("{at}.buffer"),
-            format!("buffer {buffer} does not exist"),
-        )
-    })?;
+    let data = doc
+        .buffers
+        .get(buffer)
+        .ok_or_else(|| {
+            Error::invalid(
+                format!("{at}.buffer"),
+                format!("buffer {buffer} does not exist"),
+            )
+        })?
+        .as_bytes();
     let src = offset
         .checked_add(length)
         .and_then(|end| data.get(offset as usize..end as usize))

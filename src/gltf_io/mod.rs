@@ -15,10 +15,12 @@
 //! - [`validate`]: what the spec calls an error, refused at read time
 //! - [`primitive`]: [`PrimitiveData`] out of and back into a document
 //! - [`json_merge`]: keeps what the typed JSON model loses
-//! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically
+//! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically, streamed from the buffers in memory
+//! - `buffer_data`: buffers held in the element type they were made in, shared with the writer
 //! - [`error`]: [`Error`], located by JSON path
 
 pub mod accessor;
+mod buffer_data;
 pub mod dequantize_nodes;
 pub mod document;
 pub mod error;
@@ -39,4 +41,4 @@ pub use primitive::{
     replace_primitive, replace_primitive_owned, Attribute, PrimitiveData, PrimitiveSize, Values,
 };
 pub use quantize::{quantize, Quantization};
-pub use write::{encode, fallback_path, to_glb_bytes, write, Files, WriteOptions};
+pub use write::{encode, fallback_path, to_glb_bytes, write, Files, OutputFile, WriteOptions};

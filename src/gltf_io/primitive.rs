@@ -6,14 +6,13 @@
 //! extensions, extras) and refuses Draco-compressed primitives rather than reading their
 //! placeholder accessors, which hold zeros.
 
-use std::borrow::Cow;
-
 use gltf_json::accessor::{ComponentType, GenericComponentType, Type};
 use gltf_json::mesh::Mode;
 use gltf_json::validation::{Checked, USize64};
 use serde_json::{json, Map, Value};
 
 use super::accessor::{self, component_size, vector_type};
+use super::buffer_data::BufferData;
 use super::document::{Document, ReadOptions};
 use super::error::{Error, Result};
 use super::validate::is_triangle_mode;
@@ -326,24 +325,21 @@ pub fn replace_primitive_owned(
         indices: index_data,
         targets: target_data,
     } = data;
-    // Every array is at most 4 bytes per component, plus up to 3 bytes of alignment each.
-    let arrays = attribute_data.iter().chain(target_data.iter().flatten());
-    let bytes: usize = arrays.map(|a| 4 * a.values.len() + 3).sum::<usize>() + 4 * index_data.len();
-    doc.reserve_views(bytes);
     let mut attributes = Map::new();
     for a in attribute_data {
-        attributes.insert(a.name.clone(), json!(push_attribute(doc, &a)));
+        let name = a.name.clone();
+        attributes.insert(name, json!(push_attribute(doc, a)));
     }
     let mut targets = Vec::new();
     for t in target_data {
         let mut obj = Map::new();
         for a in t {
-            obj.insert(a.name.clone(), json!(push_target_attribute(doc, &a)));
+            let name = a.name.clone();
+            obj.insert(name, json!(push_target_attribute(doc, a)));
         }
         targets.push(Value::Object(obj));
     }
-    let indices = push_indices(doc, &index_data, vertices);
-    drop(index_data);
+    let indices = push_indices(doc, index_data, vertices);
     let obj = json
         .as_object_mut()
         .ok_or_else(|| Error::invalid(&at, "is not an object"))?;
@@ -389,11 +385,11 @@ pub(crate) fn collect_accessor_refs(prim: &Value, out: &mut std::collections::BT
 }
 
 /// Writes one attribute as a new accessor; floats as FLOAT, integers in their original type.
-fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
+/// Float and 32-bit arrays move into the document uncopied.
+fn push_attribute(doc: &mut Document, a: Attribute) -> usize {
     let n = a.components.max(1);
-    let (ct, mut bytes, min, max): (ComponentType, Cow<'_, [u8]>, Vec<Value>, Vec<Value>) = match &a
-        .values
-    {
+    let count = a.count();
+    let (ct, data, min, max): (ComponentType, BufferData, Vec<Value>, Vec<Value>) = match a.values {
         Values::Float(v) => {
             let (mut lo, mut hi) = (vec![f32::INFINITY; n], vec![f32::NEG_INFINITY; n]);
             for e in v.chunks_exact(n) {
@@ -404,7 +400,7 @@ fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
             }
             (
                 ComponentType::F32,
-                le_bytes(v),
+                BufferData::floats(v),
                 lo.iter().map(|x| json!(*x)).collect(),
                 hi.iter().map(|x| json!(*x)).collect(),
             )
@@ -420,36 +416,39 @@ fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
                 lo[k % n] = lo[k % n].min(*x);
                 hi[k % n] = hi[k % n].max(*x);
             }
-            let bytes = match ct {
-                ComponentType::U8 => v.iter().map(|x| *x as u8).collect(),
-                ComponentType::U16 => v.iter().flat_map(|x| (*x as u16).to_le_bytes()).collect(),
-                _ => le_bytes(v),
-            };
-            (
-                ct,
-                bytes,
+            let (lo, hi) = (
                 lo.iter().map(|x| json!(*x)).collect(),
                 hi.iter().map(|x| json!(*x)).collect(),
-            )
+            );
+            let data = match ct {
+                ComponentType::U8 => BufferData::Bytes(v.iter().map(|x| *x as u8).collect()),
+                ComponentType::U16 => {
+                    BufferData::Bytes(v.iter().flat_map(|x| (*x as u16).to_le_bytes()).collect())
+                }
+                _ => BufferData::words(v),
+            };
+            (ct, data, lo, hi)
         }
     };
     // Vertex attribute elements must start on 4-byte boundaries: pad them when they are shorter.
     let elem = n * component_size(ct);
     let stride = elem.div_ceil(4) * 4;
-    if stride != elem {
-        bytes = bytes
-            .chunks(elem)
-            .flat_map(|e| {
-                e.iter()
-                    .copied()
-                    .chain(std::iter::repeat_n(0, stride - elem))
-            })
-            .collect::<Vec<u8>>()
-            .into();
-    }
-    let count = a.count();
-    let view = doc.push_view(
-        &bytes,
+    let data = if stride != elem {
+        BufferData::Bytes(
+            data.as_bytes()
+                .chunks(elem)
+                .flat_map(|e| {
+                    e.iter()
+                        .copied()
+                        .chain(std::iter::repeat_n(0, stride - elem))
+                })
+                .collect(),
+        )
+    } else {
+        data
+    };
+    let view = doc.push_array_view(
+        data,
         (stride != elem).then_some(stride),
         Some(gltf_json::buffer::Target::ArrayBuffer),
     );
@@ -469,7 +468,7 @@ fn push_attribute(doc: &mut Document, a: &Attribute) -> usize {
 /// Writes a morph target's displacements sparse when that is smaller (most of a dense mesh
 /// often does not move), dense otherwise. A target that moves nothing becomes an accessor
 /// without data, which reads as zeros.
-fn push_target_attribute(doc: &mut Document, a: &Attribute) -> usize {
+fn push_target_attribute(doc: &mut Document, a: Attribute) -> usize {
     let (Values::Float(v), n) = (&a.values, a.components.max(1)) else {
         return push_attribute(doc, a);
     };
@@ -544,63 +543,40 @@ fn push_target_attribute(doc: &mut Document, a: &Attribute) -> usize {
     index
 }
 
-/// Writes a triangle list as u16 indices when they fit (65535 is the restart value), else u32.
-fn push_indices(doc: &mut Document, indices: &[u32], vertices: usize) -> usize {
-    let (ct, bytes): (ComponentType, Cow<'_, [u8]>) = if vertices <= 65535 {
+/// Writes a triangle list as u16 indices when they fit (65535 is the restart value), else u32
+/// (moved into the document uncopied).
+fn push_indices(doc: &mut Document, indices: Vec<u32>, vertices: usize) -> usize {
+    let (lo, hi) = (indices.iter().min(), indices.iter().max());
+    let bounds = lo.zip(hi).map(|(l, h)| (json!([l]), json!([h])));
+    let count = indices.len();
+    let (ct, data) = if vertices <= 65535 {
         (
             ComponentType::U16,
-            indices
-                .iter()
-                .flat_map(|i| (*i as u16).to_le_bytes())
-                .collect(),
+            BufferData::Bytes(
+                indices
+                    .iter()
+                    .flat_map(|i| (*i as u16).to_le_bytes())
+                    .collect(),
+            ),
         )
     } else {
-        (ComponentType::U32, le_bytes(indices))
+        (ComponentType::U32, BufferData::words(indices))
     };
-    let view = doc.push_view(
-        &bytes,
+    let view = doc.push_array_view(
+        data,
         None,
         Some(gltf_json::buffer::Target::ElementArrayBuffer),
     );
-    let (lo, hi) = (indices.iter().min(), indices.iter().max());
-    let bounds = lo.zip(hi).map(|(l, h)| (json!([l]), json!([h])));
     push_accessor(
         doc,
         view,
-        indices.len(),
+        count,
         ct,
         Type::Scalar,
         false,
         bounds.as_ref().map(|b| b.0.clone()),
         bounds.map(|b| b.1),
     )
-}
-
-/// The little-endian bytes of 4-byte numbers: on little-endian machines the numbers' own memory,
-/// uncopied (a dense mesh's arrays are hundreds of megabytes).
-fn le_bytes<T: Copy + ToLeBytes>(values: &[T]) -> Cow<'_, [u8]> {
-    if cfg!(target_endian = "little") {
-        Cow::Borrowed(meshopt::typed_to_bytes(values))
-    } else {
-        Cow::Owned(values.iter().flat_map(|x| x.le()).collect())
-    }
-}
-
-/// `to_le_bytes` of the 4-byte number types written here.
-trait ToLeBytes {
-    fn le(self) -> [u8; 4];
-}
-
-impl ToLeBytes for f32 {
-    fn le(self) -> [u8; 4] {
-        self.to_le_bytes()
-    }
-}
-
-impl ToLeBytes for u32 {
-    fn le(self) -> [u8; 4] {
-        self.to_le_bytes()
-    }
 }
 
 /// Appends an accessor over the whole of `view`; returns its index.

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{json, Map, Value};
 
+use super::buffer_data::Pieces;
 use super::document::Document;
 use super::error::{Error, Result};
 use super::meshopt_encode::{self, Compression};
@@ -52,13 +53,62 @@ pub fn fallback_path(path: &Path) -> PathBuf {
     path.with_extension("fallback.bin")
 }
 
-/// The files of one output, each with its bytes, in the order they are written.
-pub type Files = Vec<(PathBuf, Vec<u8>)>;
+/// One file of an output: its path and its bytes, held as the pieces they are made of (most of
+/// them shared with the document's buffers, so encoding a dense mesh copies none of its arrays).
+#[derive(Debug, Clone)]
+pub struct OutputFile {
+    /// Where it goes.
+    pub path: PathBuf,
+    bytes: Pieces,
+}
+
+impl OutputFile {
+    fn new(path: PathBuf, bytes: Pieces) -> Self {
+        OutputFile { path, bytes }
+    }
+
+    /// Its length in bytes.
+    pub fn len(&self) -> u64 {
+        self.bytes.len() as u64
+    }
+
+    /// Whether it has no bytes.
+    pub fn is_empty(&self) -> bool {
+        self.bytes.is_empty()
+    }
+
+    /// Its bytes in one vector.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        self.bytes.concat()
+    }
+
+    /// Whether `other` holds exactly its bytes.
+    pub fn same_as(&self, other: &[u8]) -> bool {
+        if other.len() != self.bytes.len() {
+            return false;
+        }
+        let mut rest = other;
+        self.bytes.iter().all(|piece| {
+            let (head, tail) = rest.split_at(piece.len());
+            rest = tail;
+            head == piece
+        })
+    }
+
+    /// Writes it to a temporary file beside its path, then renames it into place.
+    pub fn write_atomically(&self) -> Result<()> {
+        write_pieces_atomically(&self.path, self.bytes.iter())
+    }
+}
+
+/// The files of one output, in the order they are to be written (a file before the file that
+/// refers to it).
+pub type Files = Vec<OutputFile>;
 
 /// Writes `doc` to `path` (`.glb`, or `.gltf` + `<stem>.bin`).
 pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
-    for (file, bytes) in encode(doc, path, opts)? {
-        atomic_write(&file, &bytes)?;
+    for file in encode(doc, path, opts)? {
+        file.write_atomically()?;
     }
     Ok(())
 }
@@ -101,22 +151,26 @@ pub fn encode(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<Files>
         opts.compression,
         fallback.as_deref(),
     )?;
-    if let (Some(f), Some(bytes)) = (&fallback, &fallback_bytes) {
-        atomic_write(f, bytes)?;
+    let mut files = Vec::with_capacity(3);
+    if let (Some(f), Some(bytes)) = (fallback, fallback_bytes) {
+        files.push(OutputFile::new(f, bytes.into()));
     }
     if as_glb {
         let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
-        Ok(vec![(path.to_path_buf(), glb::assemble(&text, &bin))])
+        let (head, tail) = glb::frame(&text, bin.len());
+        let mut glb = Pieces::from(head);
+        glb.extend(bin);
+        glb.push_bytes(tail.to_vec());
+        files.push(OutputFile::new(path.to_path_buf(), glb));
     } else {
         let mut text = serde_json::to_vec_pretty(&json).map_err(|e| Error::invalid(&shown, e))?;
         text.push(b'\n');
-        let mut files = Vec::with_capacity(2);
         if let Some(bin_path) = bin_path.filter(|_| !bin.is_empty()) {
-            files.push((bin_path, bin));
+            files.push(OutputFile::new(bin_path, bin));
         }
-        files.push((path.to_path_buf(), text));
-        Ok(files)
+        files.push(OutputFile::new(path.to_path_buf(), text.into()));
     }
+    Ok(files)
 }
 
 /// The `.glb` bytes of `doc`, without touching any file: for callers that keep the result in
@@ -131,7 +185,7 @@ pub fn to_glb_bytes(doc: &Document, compression: Option<Compression>) -> Result<
     }
     let (json, bin, _) = assemble(doc, false, None, compression, None)?;
     let text = serde_json::to_vec(&json).map_err(|e| Error::invalid("json", e))?;
-    Ok(glb::assemble(&text, &bin))
+    Ok(glb::assemble(&text, &bin.concat()))
 }
 
 fn parent_dir(path: &Path) -> &Path {
@@ -195,6 +249,12 @@ fn refuse_overwriting_input(
 
 /// Writes `bytes` to a temporary file in `path`'s folder, then renames it over `path`.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_pieces_atomically(path, std::iter::once(bytes))
+}
+
+/// Writes the concatenation of `pieces` to a temporary file in `path`'s folder, flushes it to
+/// disk, then renames it over `path`: a reader sees the old file or the whole new one.
+fn write_pieces_atomically<'a>(path: &Path, pieces: impl Iterator<Item = &'a [u8]>) -> Result<()> {
     let shown = path.display().to_string();
     let mut builder = tempfile::Builder::new();
     builder.prefix(".g2tess-").suffix(".tmp");
@@ -204,10 +264,17 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
         use std::os::unix::fs::PermissionsExt as _;
         builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
-    let mut tmp = builder
+    let tmp = builder
         .tempfile_in(parent_dir(path))
         .map_err(|e| Error::io(&shown, e))?;
-    tmp.write_all(bytes).map_err(|e| Error::io(&shown, e))?;
+    // Small pieces (headers, padding) are gathered; large ones go to the file directly.
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, tmp);
+    for piece in pieces {
+        out.write_all(piece).map_err(|e| Error::io(&shown, e))?;
+    }
+    let tmp = out
+        .into_inner()
+        .map_err(|e| Error::io(&shown, e.into_error()))?;
     tmp.as_file().sync_all().map_err(|e| Error::io(&shown, e))?;
     tmp.persist(path).map_err(|e| Error::io(&shown, e.error))?;
     Ok(())
@@ -221,7 +288,7 @@ fn assemble(
     bin_path: Option<&Path>,
     compression: Option<Compression>,
     fallback_path: Option<&Path>,
-) -> Result<(Value, Vec<u8>, Option<Vec<u8>>)> {
+) -> Result<(Value, Pieces, Option<Vec<u8>>)> {
     let now = serde_json::to_value(&doc.root).map_err(|e| Error::invalid("json", e))?;
     let mut out = json_merge::merge(&doc.base, &now, &doc.raw);
     let root = out
@@ -297,20 +364,20 @@ fn assemble(
         .and_then(Value::as_array)
         .cloned()
         .unwrap_or_default();
-    let mut bin = Vec::new();
+    let mut bin = Pieces::default();
     let mut views = Vec::new();
     let mut view_map = vec![None; keep_view.len()];
     for (i, keep) in keep_view.iter().enumerate() {
         if !*keep {
             continue;
         }
-        let bytes = doc.view_bytes(i)?;
+        let piece = doc.view_piece(i)?;
         let mut v = typed_views[i].clone();
-        align4(&mut bin);
+        bin.align4();
         v["buffer"] = json!(0);
         v["byteOffset"] = json!(bin.len());
-        v["byteLength"] = json!(bytes.len());
-        bin.extend_from_slice(bytes);
+        v["byteLength"] = json!(piece.as_bytes().len());
+        bin.push(piece);
         view_map[i] = Some(views.len());
         views.push(v);
     }
@@ -356,7 +423,12 @@ fn assemble(
                 .iter()
                 .filter_map(|(v, f)| Some((view_map.get(*v).copied().flatten()?, f.clone())))
                 .collect();
-            meshopt_encode::compress(root, &mut views, &mut bin, &filtered, c.fallback)?
+            // The compressor rewrites the buffer: it works on one contiguous copy.
+            let mut flat = bin.concat();
+            let fallback =
+                meshopt_encode::compress(root, &mut views, &mut flat, &filtered, c.fallback)?;
+            bin = flat.into();
+            fallback
         }
         None => None,
     };
@@ -365,7 +437,7 @@ fn assemble(
     let mut buffers = if bin.is_empty() && fallback.is_none() {
         vec![]
     } else {
-        align4(&mut bin);
+        bin.align4();
         let mut b = json!({ "byteLength": bin.len() });
         if let Some(u) = file_uri(bin_path) {
             b["uri"] = json!(u);
@@ -430,12 +502,6 @@ const URI_ESCAPES: &percent_encoding::AsciiSet = &percent_encoding::CONTROLS
     .add(b'|')
     .add(b'}')
     .add(b':');
-
-fn align4(bin: &mut Vec<u8>) {
-    while bin.len() % 4 != 0 {
-        bin.push(0);
-    }
-}
 
 fn set_array(root: &mut Map<String, Value>, key: &str, items: Vec<Value>) {
     if items.is_empty() {
@@ -539,7 +605,7 @@ fn for_each_view_ref(root: &mut Map<String, Value>, f: &mut dyn FnMut(&mut u64))
 fn embed_external_images(
     doc: &Document,
     root: &mut Map<String, Value>,
-    bin: &mut Vec<u8>,
+    bin: &mut Pieces,
     views: &mut Vec<Value>,
 ) -> Result<()> {
     for (i, image) in arr(root, "images").enumerate() {
@@ -570,9 +636,9 @@ fn embed_external_images(
                     "cannot tell the image's type to embed it (expected png, jpeg, webp or ktx2)",
                 )
             })?;
-        align4(bin);
+        bin.align4();
         views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() }));
-        bin.extend_from_slice(&bytes);
+        bin.push_bytes(bytes);
         let obj = image.as_object_mut().expect("images are objects");
         obj.remove("uri");
         obj.insert("bufferView".into(), json!(views.len() - 1));

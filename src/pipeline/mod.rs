@@ -34,12 +34,12 @@ pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<Fi
     let started = Instant::now();
     let (mut report, files) = encode_file(input, output, options)?;
     let write_start = Instant::now();
-    for (file, bytes) in &files {
-        gltf_io::write::atomic_write(file, bytes).map_err(|e| Error::gltf(output, e))?;
+    for file in &files {
+        file.write_atomically()
+            .map_err(|e| Error::gltf(output, e))?;
     }
     report.times.write += write_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
-    report.bytes_out = file_size(output);
     Ok(report)
 }
 
@@ -67,10 +67,7 @@ pub fn encode_file(
     report.times.write += encode_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
     report.bytes_in = file_size(input);
-    report.bytes_out = files
-        .iter()
-        .find(|(f, _)| f == output)
-        .map_or(0, |(_, b)| b.len() as u64);
+    report.bytes_out = files.iter().map(gltf_io::OutputFile::len).sum();
     Ok((report, files))
 }
 
