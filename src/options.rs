@@ -88,6 +88,11 @@ pub struct Options {
     /// With `compress`, also write the uncompressed data to `<output>.fallback.bin`.
     /// Default: [`DEFAULT_COMPRESS_FALLBACK`].
     pub compress_fallback: bool,
+    /// Measure the surface's continuity across every edge for the report
+    /// ([`crate::pipeline::MeshReport::edges`]): six extra surface evaluations per edge, a
+    /// tenth of the whole run at low levels, so only when someone will read the figures.
+    /// It changes the report, never the output. Default: `false`.
+    pub measure_continuity: bool,
 }
 
 impl Default for Options {
@@ -109,6 +114,7 @@ impl Default for Options {
             quantize: DEFAULT_QUANTIZE,
             compress: DEFAULT_COMPRESS,
             compress_fallback: DEFAULT_COMPRESS_FALLBACK,
+            measure_continuity: false,
         }
     }
 }

@@ -325,3 +325,34 @@ fn output_normals_are_continuous_across_smooth_edges_and_jump_at_creases() {
         max(&sharp_jumps)
     );
 }
+
+#[test]
+fn continuity_is_measured_for_the_report_only_when_asked_and_never_changes_the_output() {
+    let dir = corpus::temp_dir();
+    let input = dir.path().join("soup.gltf");
+    std::fs::write(&input, gltf("Soup", None, &[split_normal_prim()])).unwrap();
+    let mut options = g2tess::options::Options::default();
+    options.level = 3;
+    options.h = 0.2;
+    options.crease_angle = 180.0;
+    let (quiet_out, measured_out) = (dir.path().join("a.glb"), dir.path().join("b.glb"));
+    let quiet = g2tess::pipeline::process_file(&input, &quiet_out, &options).unwrap();
+    options.measure_continuity = true;
+    let measured = g2tess::pipeline::process_file(&input, &measured_out, &options).unwrap();
+
+    let (q, m) = (&quiet.meshes[0].edges, &measured.meshes[0].edges);
+    let counts = |e: &g2tess::pipeline::EdgeFigures| (e.smooth_edges, e.crease_edges, e.open_edges);
+    assert_eq!(counts(q), counts(m));
+    assert!(q.smooth_edges > 0 && q.crease_edges == 0, "{q:?}");
+    assert_eq!((q.max_normal_jump_deg, q.max_gap), (None, None));
+    // G2 across smooth edges: the two sides agree to rounding (1e-13° measured in the surface
+    // tests), however the input normals were split.
+    let jump = m.max_normal_jump_deg.expect("measured");
+    let gap = m.max_gap.expect("measured");
+    assert!(jump < 1e-9, "normal jump {jump}°");
+    assert!(gap < 1e-12, "gap {gap}");
+    assert_eq!(
+        std::fs::read(&quiet_out).unwrap(),
+        std::fs::read(&measured_out).unwrap()
+    );
+}

@@ -213,6 +213,7 @@ impl Args {
             base,
             flags: self.flag_settings(),
             sidecar: self.sidecar.clone(),
+            measure_continuity: self.report.is_some(),
         };
         layers.resolve(None)?;
         Ok(layers)
@@ -254,6 +255,8 @@ pub struct Layers {
     base: Options,
     flags: ConfigFile,
     sidecar: Option<PathBuf>,
+    /// A report will be written: measure what it shows.
+    measure_continuity: bool,
 }
 
 impl Layers {
@@ -267,6 +270,7 @@ impl Layers {
         }
         let mut opts = opts.overlay(&self.flags);
         opts.sidecar = self.sidecar.clone();
+        opts.measure_continuity = self.measure_continuity;
         opts.validate("command line")?;
         Ok(opts)
     }

@@ -16,10 +16,12 @@
 //! - [`primitive`]: [`PrimitiveData`] out of and back into a document
 //! - [`json_merge`]: keeps what the typed JSON model loses
 //! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically, streamed from the buffers in memory
+//! - `bounds`: accessor `min`/`max`, in parallel
 //! - `buffer_data`: buffers held in the element type they were made in, shared with the writer
 //! - [`error`]: [`Error`], located by JSON path
 
 pub mod accessor;
+mod bounds;
 mod buffer_data;
 pub mod dequantize_nodes;
 pub mod document;

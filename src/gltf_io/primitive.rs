@@ -12,6 +12,7 @@ use gltf_json::validation::{Checked, USize64};
 use serde_json::{json, Map, Value};
 
 use super::accessor::{self, component_size, vector_type};
+use super::bounds;
 use super::buffer_data::BufferData;
 use super::document::{Document, ReadOptions};
 use super::error::{Error, Result};
@@ -308,7 +309,8 @@ pub fn replace_primitive_owned(
         .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
     collect_accessor_refs(&json, &mut doc.replaced_accessors);
     let vertices = data.vertex_count();
-    if let Some(bad) = data.indices.iter().find(|i| **i as usize >= vertices) {
+    let index_bounds = bounds::uint_bounds(&data.indices);
+    if let Some((_, bad)) = index_bounds.filter(|(_, hi)| *hi as usize >= vertices) {
         return Err(Error::invalid(
             &at,
             format!("new index {bad} is not below the vertex count {vertices}"),
@@ -339,7 +341,7 @@ pub fn replace_primitive_owned(
         }
         targets.push(Value::Object(obj));
     }
-    let indices = push_indices(doc, index_data, vertices);
+    let indices = push_indices(doc, index_data, index_bounds, vertices);
     let obj = json
         .as_object_mut()
         .ok_or_else(|| Error::invalid(&at, "is not an object"))?;
@@ -391,13 +393,7 @@ fn push_attribute(doc: &mut Document, a: Attribute) -> usize {
     let count = a.count();
     let (ct, data, min, max): (ComponentType, BufferData, Vec<Value>, Vec<Value>) = match a.values {
         Values::Float(v) => {
-            let (mut lo, mut hi) = (vec![f32::INFINITY; n], vec![f32::NEG_INFINITY; n]);
-            for e in v.chunks_exact(n) {
-                for (k, x) in e.iter().enumerate() {
-                    lo[k] = lo[k].min(*x);
-                    hi[k] = hi[k].max(*x);
-                }
-            }
+            let (lo, hi) = bounds::float_bounds(&v, n);
             (
                 ComponentType::F32,
                 BufferData::floats(v),
@@ -412,9 +408,11 @@ fn push_attribute(doc: &mut Document, a: Attribute) -> usize {
                 _ => ComponentType::U32,
             };
             let (mut lo, mut hi) = (vec![u32::MAX; n], vec![0u32; n]);
-            for (k, x) in v.iter().enumerate() {
-                lo[k % n] = lo[k % n].min(*x);
-                hi[k % n] = hi[k % n].max(*x);
+            for e in v.chunks_exact(n) {
+                for (k, x) in e.iter().enumerate() {
+                    lo[k] = lo[k].min(*x);
+                    hi[k] = hi[k].max(*x);
+                }
             }
             let (lo, hi) = (
                 lo.iter().map(|x| json!(*x)).collect(),
@@ -545,9 +543,13 @@ fn push_target_attribute(doc: &mut Document, a: Attribute) -> usize {
 
 /// Writes a triangle list as u16 indices when they fit (65535 is the restart value), else u32
 /// (moved into the document uncopied).
-fn push_indices(doc: &mut Document, indices: Vec<u32>, vertices: usize) -> usize {
-    let (lo, hi) = (indices.iter().min(), indices.iter().max());
-    let bounds = lo.zip(hi).map(|(l, h)| (json!([l]), json!([h])));
+fn push_indices(
+    doc: &mut Document,
+    indices: Vec<u32>,
+    bounds: Option<(u32, u32)>,
+    vertices: usize,
+) -> usize {
+    let bounds = bounds.map(|(l, h)| (json!([l]), json!([h])));
     let count = indices.len();
     let (ct, data) = if vertices <= 65535 {
         (

@@ -150,7 +150,11 @@ pub fn smooth_mesh(
             .into_iter()
             .map(|w| format!("mesh {}: {w}", input.mesh)),
     );
-    report.edges = EdgeFigures::measure(surface.as_ref(), &topo, &params.h);
+    report.edges = if options.measure_continuity {
+        EdgeFigures::measure(surface.as_ref(), &topo, &params.h)
+    } else {
+        EdgeFigures::count(&topo, &params.h)
+    };
     report.times.surface = lap(&clock, report.times.sharpness);
 
     let tess_start = Instant::now();

@@ -84,8 +84,9 @@ pub struct PrimitiveReport {
     pub cache: CacheFigures,
 }
 
-/// Continuity of the surface across the mesh's edges, sampled at three points per edge away
-/// from the corners (where only G¹ is expected).
+/// The mesh's edges by kind, and the continuity of the surface across them, sampled at three
+/// points per edge away from the corners (where only G¹ is expected) when asked for
+/// ([`crate::options::Options::measure_continuity`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct EdgeFigures {
     /// Interior edges blended (h > 0).
@@ -94,63 +95,106 @@ pub struct EdgeFigures {
     pub crease_edges: usize,
     /// Boundary, non-manifold and degenerate edges (never blended).
     pub open_edges: usize,
-    /// Largest angle between the two sides' normals across a smooth edge, in degrees.
-    pub max_normal_jump_deg: f64,
+    /// Largest angle between the two sides' normals across a smooth edge, in degrees (`None`
+    /// when not measured).
+    pub max_normal_jump_deg: Option<f64>,
     /// Largest distance between the two sides' positions across any interior edge, relative
-    /// to the mean edge length (0 means watertight before any sharing of samples).
-    pub max_gap: f64,
+    /// to the mean edge length (0 means watertight before any sharing of samples; `None` when
+    /// not measured).
+    pub max_gap: Option<f64>,
+}
+
+/// The lattice whose edge points are measured: 4 segments put points at a quarter, half and
+/// three quarters of every edge.
+const MEASURE_LEVEL: u32 = 4;
+
+/// Lattice point `(i, j)` of level [`MEASURE_LEVEL`] at barycentrics `b` (multiples of 1/4).
+fn lattice_point(b: [f64; 3]) -> (u32, u32) {
+    let n = f64::from(MEASURE_LEVEL);
+    ((b[1] * n).round() as u32, (b[2] * n).round() as u32)
 }
 
 impl EdgeFigures {
-    /// Measures `surface` over every edge of `topo` with blend widths `h`.
+    /// Counts the edges of `topo` by kind under blend widths `h`, measuring nothing.
+    pub fn count(topo: &Topology, h: &[f64]) -> EdgeFigures {
+        let mut figures = EdgeFigures::default();
+        for (e, edge) in topo.edges.iter().enumerate() {
+            figures.add(&kind_count(e, edge.kind, h));
+        }
+        figures
+    }
+
+    /// Counts the edges of `topo` and measures `surface` across them.
     pub fn measure(surface: &dyn Surface, topo: &Topology, h: &[f64]) -> EdgeFigures {
         let mean = crate::continuity::mean_edge_length(topo).max(f64::MIN_POSITIVE);
         // Edges are measured in parallel; sums and maxima do not depend on the order.
-        topo.edges
+        let (mut figures, jump, gap) = topo
+            .edges
             .par_iter()
             .enumerate()
             .map(|(e, edge)| {
-                let mut figures = EdgeFigures::default();
+                let counts = kind_count(e, edge.kind, h);
+                let (mut jump, mut gap) = (0.0f64, 0.0f64);
                 if edge.kind != EdgeKind::Interior {
-                    figures.open_edges += 1;
-                    return figures;
-                }
-                let smooth = h.get(e).is_some_and(|&v| v > 0.0);
-                if smooth {
-                    figures.smooth_edges += 1;
-                } else {
-                    figures.crease_edges += 1;
+                    return (counts, jump, gap);
                 }
                 let (f, k) = (edge.tris[0].0 .0 as usize, edge.tris[0].1 as usize);
                 let Some(n) = topo.neighbours[f][k] else {
-                    return figures;
+                    return (counts, jump, gap);
                 };
                 let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));
-                for x in [0.25, 0.5, 0.75] {
+                // The points at a quarter, half and three quarters of the edge are points of
+                // both triangles' level-4 lattices, so both sides evaluate them through the
+                // surface's cached lattice weights (bit for bit what `evaluate` gives there).
+                let (mut on_f, mut on_g) = ([(0, 0); 3], [(0, 0); 3]);
+                for (m, x) in [0.25, 0.5, 0.75].into_iter().enumerate() {
                     let mut on_edge = [0.0; 3];
                     on_edge[(k + 1) % 3] = 1.0 - x;
                     on_edge[(k + 2) % 3] = x;
-                    let a = surface.evaluate(f, on_edge);
-                    let b = surface.evaluate(g, map_point(k, slots, on_edge));
-                    figures.max_gap = figures
-                        .max_gap
-                        .max((a.position - b.position).length() / mean);
-                    if smooth {
-                        figures.max_normal_jump_deg = figures
-                            .max_normal_jump_deg
-                            .max(angle_deg(a.normal, b.normal));
+                    on_f[m] = lattice_point(on_edge);
+                    on_g[m] = lattice_point(map_point(k, slots, on_edge));
+                }
+                let (mut a, mut b) = (Vec::with_capacity(3), Vec::with_capacity(3));
+                surface.evaluate_lattice_points(f, MEASURE_LEVEL, &on_f, &mut a);
+                surface.evaluate_lattice_points(g, MEASURE_LEVEL, &on_g, &mut b);
+                for (a, b) in a.iter().zip(&b) {
+                    gap = gap.max((a.position - b.position).length() / mean);
+                    if counts.smooth_edges > 0 {
+                        jump = jump.max(angle_deg(a.normal, b.normal));
                     }
                 }
-                figures
+                (counts, jump, gap)
             })
-            .reduce(EdgeFigures::default, |a, b| EdgeFigures {
-                smooth_edges: a.smooth_edges + b.smooth_edges,
-                crease_edges: a.crease_edges + b.crease_edges,
-                open_edges: a.open_edges + b.open_edges,
-                max_normal_jump_deg: a.max_normal_jump_deg.max(b.max_normal_jump_deg),
-                max_gap: a.max_gap.max(b.max_gap),
-            })
+            .reduce(
+                || (EdgeFigures::default(), 0.0, 0.0),
+                |mut a, b| {
+                    a.0.add(&b.0);
+                    (a.0, a.1.max(b.1), a.2.max(b.2))
+                },
+            );
+        figures.max_normal_jump_deg = Some(jump);
+        figures.max_gap = Some(gap);
+        figures
     }
+
+    fn add(&mut self, other: &EdgeFigures) {
+        self.smooth_edges += other.smooth_edges;
+        self.crease_edges += other.crease_edges;
+        self.open_edges += other.open_edges;
+    }
+}
+
+/// The count of one edge of kind `kind` with blend width `h[e]`.
+fn kind_count(e: usize, kind: EdgeKind, h: &[f64]) -> EdgeFigures {
+    let mut one = EdgeFigures::default();
+    if kind != EdgeKind::Interior {
+        one.open_edges = 1;
+    } else if h.get(e).is_some_and(|&v| v > 0.0) {
+        one.smooth_edges = 1;
+    } else {
+        one.crease_edges = 1;
+    }
+    one
 }
 
 /// One mesh.
