@@ -7,6 +7,7 @@
 //! Conventions: corner `k` of a triangle is opposite its edge `k`; edge `k` runs from corner
 //! `(k + 1) % 3` (called `i`) to corner `(k + 2) % 3` (called `j`).
 
+use rayon::slice::ParallelSliceMut as _;
 use std::collections::HashMap;
 use std::fmt;
 
@@ -158,7 +159,8 @@ impl Topology {
                 half.push(([a.min(b), a.max(b)], TriId(t as u32), k as u8));
             }
         }
-        half.sort_unstable();
+        // Entries are distinct, so the parallel sort's result is the one order there is.
+        half.par_sort_unstable();
 
         let mut edges: Vec<Edge> = Vec::new();
         let mut tri_edges = vec![[EdgeId(0); 3]; tri_verts.len()];
