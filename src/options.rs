@@ -88,11 +88,12 @@ pub struct Options {
     /// With `compress`, also write the uncompressed data to `<output>.fallback.bin`.
     /// Default: [`DEFAULT_COMPRESS_FALLBACK`].
     pub compress_fallback: bool,
-    /// Measure the surface's continuity across every edge for the report
-    /// ([`crate::pipeline::MeshReport::edges`]): six extra surface evaluations per edge, a
-    /// tenth of the whole run at low levels, so only when someone will read the figures.
-    /// It changes the report, never the output. Default: `false`.
-    pub measure_continuity: bool,
+    /// Compute the figures only a report shows: the surface's continuity across every edge
+    /// ([`crate::pipeline::MeshReport::edges`], six extra surface evaluations per edge, up to a
+    /// tenth of a run at low levels) and meshoptimizer's vertex cache figures of each output
+    /// primitive ([`crate::pipeline::PrimitiveReport::cache`], a sequential pass over the index
+    /// buffer). It changes the report, never the output. Default: `false`.
+    pub report_figures: bool,
 }
 
 impl Default for Options {
@@ -114,7 +115,7 @@ impl Default for Options {
             quantize: DEFAULT_QUANTIZE,
             compress: DEFAULT_COMPRESS,
             compress_fallback: DEFAULT_COMPRESS_FALLBACK,
-            measure_continuity: false,
+            report_figures: false,
         }
     }
 }

@@ -327,7 +327,7 @@ fn output_normals_are_continuous_across_smooth_edges_and_jump_at_creases() {
 }
 
 #[test]
-fn continuity_is_measured_for_the_report_only_when_asked_and_never_changes_the_output() {
+fn report_figures_are_computed_only_when_asked_and_never_change_the_output() {
     let dir = corpus::temp_dir();
     let input = dir.path().join("soup.gltf");
     std::fs::write(&input, gltf("Soup", None, &[split_normal_prim()])).unwrap();
@@ -337,7 +337,7 @@ fn continuity_is_measured_for_the_report_only_when_asked_and_never_changes_the_o
     options.crease_angle = 180.0;
     let (quiet_out, measured_out) = (dir.path().join("a.glb"), dir.path().join("b.glb"));
     let quiet = g2tess::pipeline::process_file(&input, &quiet_out, &options).unwrap();
-    options.measure_continuity = true;
+    options.report_figures = true;
     let measured = g2tess::pipeline::process_file(&input, &measured_out, &options).unwrap();
 
     let (q, m) = (&quiet.meshes[0].edges, &measured.meshes[0].edges);
@@ -345,6 +345,13 @@ fn continuity_is_measured_for_the_report_only_when_asked_and_never_changes_the_o
     assert_eq!(counts(q), counts(m));
     assert!(q.smooth_edges > 0 && q.crease_edges == 0, "{q:?}");
     assert_eq!((q.max_normal_jump_deg, q.max_gap), (None, None));
+    assert_eq!(quiet.meshes[0].primitives[0].cache, None);
+    // Every vertex is used, so at least one transform per vertex: ATVR ≥ 1, ACMR ≤ 3.
+    let cache = measured.meshes[0].primitives[0].cache.expect("measured");
+    assert!(
+        cache.atvr >= 1.0 && cache.acmr > 0.0 && cache.acmr <= 3.0,
+        "{cache:?}"
+    );
     // G2 across smooth edges: the two sides agree to rounding (1e-13° measured in the surface
     // tests), however the input normals were split.
     let jump = m.max_normal_jump_deg.expect("measured");

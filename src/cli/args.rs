@@ -213,7 +213,7 @@ impl Args {
             base,
             flags: self.flag_settings(),
             sidecar: self.sidecar.clone(),
-            measure_continuity: self.report.is_some(),
+            report_figures: self.report.is_some(),
         };
         layers.resolve(None)?;
         Ok(layers)
@@ -255,8 +255,8 @@ pub struct Layers {
     base: Options,
     flags: ConfigFile,
     sidecar: Option<PathBuf>,
-    /// A report will be written: measure what it shows.
-    measure_continuity: bool,
+    /// A report will be written: compute the figures only it shows.
+    report_figures: bool,
 }
 
 impl Layers {
@@ -270,7 +270,7 @@ impl Layers {
         }
         let mut opts = opts.overlay(&self.flags);
         opts.sidecar = self.sidecar.clone();
-        opts.measure_continuity = self.measure_continuity;
+        opts.report_figures = self.report_figures;
         opts.validate("command line")?;
         Ok(opts)
     }

@@ -62,10 +62,10 @@ impl Fingerprint {
                 None => h.write(b"\0absent"),
             }
         }
-        // Measuring continuity changes the report, not the output: a run with `--report` may
+        // The report's own figures change the report, not the output: a run with `--report` may
         // skip what a run without it made.
         let mut output_settings = options.clone();
-        output_settings.measure_continuity = false;
+        output_settings.report_figures = false;
         let settings = format!("{} {output_settings:?}", env!("CARGO_PKG_VERSION"));
         Fingerprint {
             inputs: format!("{:016x}", h.finish()),

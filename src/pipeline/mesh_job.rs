@@ -150,7 +150,7 @@ pub fn smooth_mesh(
             .into_iter()
             .map(|w| format!("mesh {}: {w}", input.mesh)),
     );
-    report.edges = if options.measure_continuity {
+    report.edges = if options.report_figures {
         EdgeFigures::measure(surface.as_ref(), &topo, &params.h)
     } else {
         EdgeFigures::count(&topo, &params.h)
@@ -186,7 +186,7 @@ pub fn smooth_mesh(
             vertices_in: prep.source_vertex_count,
             triangles_out: d.indices.len() / 3,
             vertices_out: d.positions.len(),
-            cache: optimize::cache_figures(&d),
+            cache: options.report_figures.then(|| optimize::cache_figures(&d)),
         });
         let data = primitive_out::build(prep, d, groups[k].start as u32, target);
         primitives.push((input.primitives[k].index, data));

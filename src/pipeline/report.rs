@@ -80,13 +80,14 @@ pub struct PrimitiveReport {
     pub triangles_out: usize,
     /// Vertices written.
     pub vertices_out: usize,
-    /// meshoptimizer's cache figures of the written index buffer.
-    pub cache: CacheFigures,
+    /// meshoptimizer's cache figures of the written index buffer (`None` unless asked for,
+    /// see [`crate::options::Options::report_figures`]).
+    pub cache: Option<CacheFigures>,
 }
 
 /// The mesh's edges by kind, and the continuity of the surface across them, sampled at three
 /// points per edge away from the corners (where only G¹ is expected) when asked for
-/// ([`crate::options::Options::measure_continuity`]).
+/// ([`crate::options::Options::report_figures`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct EdgeFigures {
     /// Interior edges blended (h > 0).
