@@ -175,7 +175,14 @@ impl G2Surface {
 type Broadcast<const L: usize> = [[[f64; L]; 3]; 10];
 
 fn broadcast<const L: usize>(net: &SoaNet) -> Broadcast<L> {
-    std::array::from_fn(|m| [0, 1, 2].map(|c| [net[c][m]; L]))
+    // Plain loops: nested `array::map` closures were not inlined, and cost more than the sums.
+    let mut out = [[[0.0; L]; 3]; 10];
+    for (m, point) in out.iter_mut().enumerate() {
+        for (lanes, coord) in point.iter_mut().zip(net) {
+            *lanes = [coord[m]; L];
+        }
+    }
+    out
 }
 
 /// Adds the weighted sums of one net to `acc[quantity][coordinate][lane]`: for each lane, the
