@@ -9,20 +9,24 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::blend::neighbour_map;
-use super::pattern::{PatternCache, PointWeights};
+use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights};
 use super::pn::{central_point, compose, pn_net, Net, B111, NEAR};
-use super::{lattice_index, Profile, Surface, SurfacePoint, H_MAX};
+use super::{LatticePart, Profile, Surface, SurfacePoint, H_MAX};
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeKind, Topology, Warning};
+
+/// A control net by coordinate, `[x, y, z][control point]`: the layout the per-point sums of
+/// [`accumulate`] read, one coordinate of one control point at a time.
+type SoaNet = [[f64; 10]; 3];
 
 /// Everything one triangle needs at evaluation time.
 #[derive(Debug, Clone)]
 struct Patch {
     /// Own PN net `b_f` (Eq. 2, with shared edge curves on unblended split edges).
-    net: Net,
+    net: SoaNet,
     /// `across[k]`: the neighbour's net composed with the map of Eq. 3, `b_g ∘ M`, for the
     /// edge opposite corner `k` (a copy of `net` where that edge is not blended).
-    across: [Net; 3],
+    across: [SoaNet; 3],
     /// Effective width of the edge opposite each corner.
     h: [f64; 3],
     /// Input corner positions and normalized input normals.
@@ -54,38 +58,47 @@ impl G2Surface {
         super::assert_belong_together(mesh, topo, h_per_edge);
 
         let (h_edge, warnings) = effective_widths(topo, h_per_edge);
-        let mut patches: Vec<Patch> = mesh
+        let corners: Vec<([DVec3; 3], [DVec3; 3])> = mesh
             .triangles
             .iter()
-            .enumerate()
-            .map(|(t, tri)| {
+            .map(|tri| {
                 let position = tri.map(|c| mesh.positions[c as usize]);
                 let face = (position[1] - position[0])
                     .cross(position[2] - position[0])
                     .normalize_or(DVec3::Z);
-                let normal = tri.map(|c| mesh.normals[c as usize].normalize_or(face));
-                let net = pn_net(position, normal);
+                (
+                    position,
+                    tri.map(|c| mesh.normals[c as usize].normalize_or(face)),
+                )
+            })
+            .collect();
+        let mut nets: Vec<Net> = corners.iter().map(|&(p, n)| pn_net(p, n)).collect();
+        share_unblended_edge_curves(topo, &h_edge, &mut nets);
+
+        let patches: Vec<Patch> = corners
+            .par_iter()
+            .enumerate()
+            .map(|(t, &(position, normal))| {
+                let h = topo.tri_edges[t].map(|e| h_edge[e.0 as usize]);
+                let net = soa(&nets[t]);
+                let across = std::array::from_fn(|k| {
+                    if h[k] > 0.0 {
+                        let n = topo.neighbours[t][k].expect("blended edges are interior");
+                        let cols = neighbour_map(k, n.slots.map(usize::from));
+                        soa(&compose(&nets[n.tri.0 as usize], cols))
+                    } else {
+                        net
+                    }
+                });
                 Patch {
                     net,
-                    across: [net; 3],
-                    h: topo.tri_edges[t].map(|e| h_edge[e.0 as usize]),
+                    across,
+                    h,
                     position,
                     normal,
                 }
             })
             .collect();
-        share_unblended_edge_curves(topo, &h_edge, &mut patches);
-
-        let nets: Vec<Net> = patches.iter().map(|p| p.net).collect();
-        patches.par_iter_mut().enumerate().for_each(|(t, patch)| {
-            for k in 0..3 {
-                if patch.h[k] > 0.0 {
-                    let n = topo.neighbours[t][k].expect("blended edges are interior");
-                    let cols = neighbour_map(k, n.slots.map(usize::from));
-                    patch.across[k] = compose(&nets[n.tri.0 as usize], cols);
-                }
-            }
-        });
 
         G2Surface {
             patches,
@@ -111,10 +124,100 @@ impl G2Surface {
         &self.warnings
     }
 
-    /// The surface point of triangle `tri` for precomputed weights.
-    #[inline]
-    fn combine(&self, tri: usize, w: &PointWeights) -> SurfacePoint {
+    /// The surface points of `L` domain points of `patch` from their weights, on its own net
+    /// `own` and, when they blend, the neighbour's net `across` (the points of one [`Lanes`]
+    /// block all blend with the same neighbour, or with none).
+    ///
+    /// Position and tangents are the sums of the pattern module's documentation (Eq. 5 and its
+    /// derivatives); the normal is `∂_u S × ∂_v S`, oriented by the interpolated input normals.
+    /// Each lane's sums run in the same order whatever `L`, so a lattice block and a single
+    /// point agree bit for bit.
+    #[inline(always)]
+    fn combine<const L: usize>(
+        patch: &Patch,
+        w: &Lanes<L>,
+        own: &Broadcast<L>,
+        across: Option<&Broadcast<L>>,
+    ) -> [SurfacePoint; L] {
+        let mut acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3]);
+        if let Some(across) = across {
+            acc = accumulate(&w.across, across, acc);
+        }
+        std::array::from_fn(|l| {
+            let v = |q: usize| DVec3::new(acc[q][0][l], acc[q][1][l], acc[q][2][l]);
+            let (position, du, dv) = (v(0), v(1), v(2));
+            let b = w.bary[l];
+            let interpolated =
+                b[0] * patch.normal[0] + b[1] * patch.normal[1] + b[2] * patch.normal[2];
+            let n = du.cross(dv);
+            let len2 = n.length_squared();
+            // |N| ≤ 1e-14·|∂_u S|·|∂_v S|: the tangents are parallel to rounding (a degenerate
+            // triangle); fall back to the interpolated input normal.
+            let normal =
+                if len2 > 1e-28 * du.length_squared() * dv.length_squared() && len2.is_finite() {
+                    let n = n / len2.sqrt();
+                    if n.dot(interpolated) < 0.0 {
+                        -n
+                    } else {
+                        n
+                    }
+                } else {
+                    interpolated.normalize_or(patch.normal[0])
+                };
+            SurfacePoint { position, normal }
+        })
+    }
+}
+
+/// A control net with every coordinate repeated in `L` lanes, `[control point][x, y, z][lane]`:
+/// the sums of [`accumulate`] are then the same operation on whole lanes, which compilers turn
+/// into SIMD arithmetic without being told.
+type Broadcast<const L: usize> = [[[f64; L]; 3]; 10];
+
+fn broadcast<const L: usize>(net: &SoaNet) -> Broadcast<L> {
+    // Plain loops: nested `array::map` closures were not inlined, and cost more than the sums.
+    let mut out = [[[0.0; L]; 3]; 10];
+    for (m, point) in out.iter_mut().enumerate() {
+        for (lanes, coord) in point.iter_mut().zip(net) {
+            *lanes = [coord[m]; L];
+        }
+    }
+    out
+}
+
+/// Adds the weighted sums of one net to `acc[quantity][coordinate][lane]`: for each lane, the
+/// control points in order, so that the result does not depend on how many lanes run together.
+///
+/// The sums are taken and returned by value, and written as plain indexed loops: kept out of
+/// memory that way, the compiler unrolls them and runs the lanes in SIMD registers.
+#[inline(always)]
+fn accumulate<const L: usize>(
+    w: &NetWeights<L>,
+    net: &Broadcast<L>,
+    mut acc: [[[f64; L]; 3]; 3],
+) -> [[[f64; L]; 3]; 3] {
+    #[allow(clippy::needless_range_loop)]
+    for m in 0..10 {
+        for q in 0..3 {
+            for c in 0..3 {
+                for l in 0..L {
+                    acc[q][c][l] += w[q][m][l] * net[m][c][l];
+                }
+            }
+        }
+    }
+    acc
+}
+
+/// A net by coordinate.
+fn soa(net: &Net) -> SoaNet {
+    [0, 1, 2].map(|c| net.map(|p| p[c]))
+}
+
+impl Surface for G2Surface {
+    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
         let patch = &self.patches[tri];
+        let w = PointWeights::at(bary, patch.h, self.profile);
         if let Some(c) = w.corner {
             let c = c as usize;
             return SurfacePoint {
@@ -122,65 +225,53 @@ impl G2Surface {
                 normal: patch.normal[c],
             };
         }
-        let [p, pu, pv] = w.basis.eval(&patch.net);
-        let b = &w.blend;
-        let (position, du, dv) = if b.beta != 0.0 || b.beta_u != 0.0 || b.beta_v != 0.0 {
-            // S = b_f + β(b_g − b_f); ∂S = ∂b_f + β(∂b_g − ∂b_f) + ∂β·(b_g − b_f).
-            let [q, qu, qv] = w.basis.eval(&patch.across[b.k as usize]);
-            let d = q - p;
-            (
-                p + b.beta * d,
-                pu + b.beta * (qu - pu) + b.beta_u * d,
-                pv + b.beta * (qv - pv) + b.beta_v * d,
-            )
-        } else {
-            (p, pu, pv)
-        };
-        let l = w.bary;
-        let interpolated = l[0] * patch.normal[0] + l[1] * patch.normal[1] + l[2] * patch.normal[2];
-        let n = du.cross(dv);
-        let len2 = n.length_squared();
-        // |N| ≤ 1e-14·|∂_u S|·|∂_v S|: the tangents are parallel to rounding (a degenerate
-        // triangle); fall back to the interpolated input normal.
-        let normal = if len2 > 1e-28 * du.length_squared() * dv.length_squared() && len2.is_finite()
-        {
-            let n = n / len2.sqrt();
-            if n.dot(interpolated) < 0.0 {
-                -n
-            } else {
-                n
-            }
-        } else {
-            interpolated.normalize_or(patch.normal[0])
-        };
-        SurfacePoint { position, normal }
-    }
-}
-
-impl Surface for G2Surface {
-    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
-        let w = PointWeights::at(bary, self.patches[tri].h, self.profile);
-        self.combine(tri, &w)
+        let own = broadcast(&patch.net);
+        let across = w.blended.then(|| broadcast(&patch.across[w.k as usize]));
+        let [p] = Self::combine(patch, &Lanes::<1>::single(&w), &own, across.as_ref());
+        p
     }
 
-    fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
-        let pattern = self.patterns.get(level, self.patches[tri].h, self.profile);
-        out.extend(pattern.points.iter().map(|w| self.combine(tri, w)));
-    }
-
-    fn evaluate_lattice_points(
+    fn evaluate_lattice_part(
         &self,
         tri: usize,
         level: u32,
-        points: &[(u32, u32)],
+        part: LatticePart,
         out: &mut Vec<SurfacePoint>,
     ) {
-        let pattern = self.patterns.get(level, self.patches[tri].h, self.profile);
-        out.extend(
-            points
-                .iter()
-                .map(|&(i, j)| self.combine(tri, &pattern.points[lattice_index(level, i, j)])),
+        let patch = &self.patches[tri];
+        let pattern = self.patterns.get(level, part, patch.h, self.profile);
+        let base = out.len();
+        out.resize(
+            base + pattern.len,
+            SurfacePoint {
+                position: DVec3::ZERO,
+                normal: DVec3::ZERO,
+            },
         );
+        let out = &mut out[base..];
+        for &(c, target) in &pattern.corners {
+            out[target as usize] = SurfacePoint {
+                position: patch.position[c as usize],
+                normal: patch.normal[c as usize],
+            };
+        }
+        let own = broadcast(&patch.net);
+        let groups = std::iter::once((None, &pattern.plain))
+            .chain((0..3).map(|k| (Some(k), &pattern.blended[k])));
+        for (k, blocks) in groups {
+            if blocks.is_empty() {
+                continue;
+            }
+            let across = k.map(|k| broadcast(&patch.across[k]));
+            for lanes in blocks {
+                let points = Self::combine(patch, lanes, &own, across.as_ref());
+                for (&target, p) in lanes.target.iter().zip(points) {
+                    if target != Lanes::<1>::PADDING {
+                        out[target as usize] = p;
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -202,18 +293,14 @@ impl Surface for PnSurface {
         self.0.evaluate(tri, bary)
     }
 
-    fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
-        self.0.evaluate_lattice(tri, level, out)
-    }
-
-    fn evaluate_lattice_points(
+    fn evaluate_lattice_part(
         &self,
         tri: usize,
         level: u32,
-        points: &[(u32, u32)],
+        part: LatticePart,
         out: &mut Vec<SurfacePoint>,
     ) {
-        self.0.evaluate_lattice_points(tri, level, points, out)
+        self.0.evaluate_lattice_part(tri, level, part, out)
     }
 }
 
@@ -254,8 +341,8 @@ fn effective_widths(topo: &Topology, h: &[f64]) -> (Vec<f64>, Vec<Warning>) {
 /// Makes every triangle along an unblended edge use one boundary curve: if their inner edge
 /// control points differ (split normals), each gets the average, oriented along the edge
 /// (PN-AEN); `b111` is then recomputed from the new edge points (Eq. 2).
-fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], patches: &mut [Patch]) {
-    let mut touched = vec![false; patches.len()];
+fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], nets: &mut [Net]) {
+    let mut touched = vec![false; nets.len()];
     for (edge, &h) in topo.edges.iter().zip(h_edge) {
         if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
             continue;
@@ -275,28 +362,26 @@ fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], patches: &mut [P
                 (t, s)
             })
             .collect();
-        let first = slots[0].1.map(|s| patches[slots[0].0].net[s]);
-        let same = slots
-            .iter()
-            .all(|&(t, s)| s.map(|s| patches[t].net[s]) == first);
+        let first = slots[0].1.map(|s| nets[slots[0].0][s]);
+        let same = slots.iter().all(|&(t, s)| s.map(|s| nets[t][s]) == first);
         if same {
             continue;
         }
         let mut sum = [DVec3::ZERO; 2];
         for &(t, s) in &slots {
-            sum[0] += patches[t].net[s[0]];
-            sum[1] += patches[t].net[s[1]];
+            sum[0] += nets[t][s[0]];
+            sum[1] += nets[t][s[1]];
         }
         let avg = sum.map(|x| x / slots.len() as f64);
         for &(t, s) in &slots {
-            patches[t].net[s[0]] = avg[0];
-            patches[t].net[s[1]] = avg[1];
+            nets[t][s[0]] = avg[0];
+            nets[t][s[1]] = avg[1];
             touched[t] = true;
         }
     }
-    for (patch, touched) in patches.iter_mut().zip(touched) {
+    for (net, touched) in nets.iter_mut().zip(touched) {
         if touched {
-            patch.net[B111] = central_point(&patch.net);
+            net[B111] = central_point(net);
         }
     }
 }

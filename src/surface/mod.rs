@@ -17,11 +17,12 @@
 //!    interpolated input normals.
 //!
 //! Speed: everything that depends only on the domain point, the three widths and the profile
-//! (Bernstein values and derivatives, subdomain, t, β and ∂β) is a [`pattern::Pattern`], built
-//! once per (level, widths, profile) and shared by every triangle; the neighbour's patch is
-//! re-expressed in the triangle's own barycentrics once per edge ([`pn::compose`]), so a point
-//! costs one Bézier evaluation outside the blending regions and two inside, and no allocation.
-//! `benches/surface.rs` measures it.
+//! (Bernstein values and derivatives, subdomain, t, β and ∂β) is folded into one weight per
+//! control point of the own and the neighbour's net and kept in a [`pattern::Pattern`], built
+//! once per (level, lattice part, widths, profile) and shared by every triangle; the neighbour's
+//! patch is re-expressed in the triangle's own barycentrics once per edge ([`pn::compose`]), so
+//! a point costs 9 dot products of length 10 outside the blending regions and of length 20
+//! inside, run for two points at a time, and no allocation. `benches/surface.rs` measures it.
 //!
 //! Module map: [`pn`] (control nets, Bernstein basis), [`profile`] (r(s)), [`blend`] (subdomain,
 //! t, β, neighbour map), [`pattern`] (geometry-free per-point weights, cached per lattice), and
@@ -89,17 +90,31 @@ pub trait Surface: Sync {
     /// (see [`lattice_index`]), appended to `out`. Fast implementations reuse a precomputed
     /// pattern; results equal [`Surface::evaluate`] at [`lattice_bary`] bit for bit.
     fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
-        out.reserve(lattice_len(level));
-        for j in 0..=level {
-            for i in 0..=level - j {
-                out.push(self.evaluate(tri, lattice_bary(level, i, j)));
-            }
-        }
+        self.evaluate_lattice_part(tri, level, LatticePart::All, out);
+    }
+
+    /// The points of one part of the level-`level` lattice (`level ≥ 1`) of triangle `tri`, in
+    /// the order of [`LatticePart::points`], appended to `out`; equal to [`Surface::evaluate`] at
+    /// [`lattice_bary`] bit for bit. The tessellator evaluates each shared edge once, from one
+    /// side, and each triangle's interior: every output vertex once, corners not at all.
+    fn evaluate_lattice_part(
+        &self,
+        tri: usize,
+        level: u32,
+        part: LatticePart,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let points = part.points(level);
+        out.reserve(points.len());
+        out.extend(
+            points
+                .iter()
+                .map(|&(i, j)| self.evaluate(tri, lattice_bary(level, i, j))),
+        );
     }
 
     /// Some points `(i, j)` of the level-`level` lattice of triangle `tri`, appended to `out` in
-    /// the order given; equal to [`Surface::evaluate`] at [`lattice_bary`] bit for bit. The
-    /// tessellator evaluates each shared edge once with it, from one side.
+    /// the order given; equal to [`Surface::evaluate`] at [`lattice_bary`] bit for bit.
     fn evaluate_lattice_points(
         &self,
         tri: usize,
@@ -112,6 +127,39 @@ pub trait Surface: Sync {
                 .iter()
                 .map(|&(i, j)| self.evaluate(tri, lattice_bary(level, i, j))),
         );
+    }
+}
+
+/// A part of a lattice, for [`Surface::evaluate_lattice_part`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum LatticePart {
+    /// Every point, in lattice order.
+    All,
+    /// The points off the triangle's boundary, in lattice order.
+    Interior,
+    /// The `n − 1` points strictly inside the edge opposite corner `k`, walked from corner
+    /// `k + 1` towards corner `k + 2`.
+    Edge(u8),
+}
+
+impl LatticePart {
+    /// Lattice coordinates `(i, j)` of the part's points of the level-`n` lattice, in order.
+    pub fn points(self, n: u32) -> Vec<(u32, u32)> {
+        match self {
+            LatticePart::All => (0..=n)
+                .flat_map(|j| (0..=n - j).map(move |i| (i, j)))
+                .collect(),
+            LatticePart::Interior => (1..n)
+                .flat_map(|j| (1..n - j).map(move |i| (i, j)))
+                .collect(),
+            LatticePart::Edge(k) => (1..n)
+                .map(|m| match k {
+                    0 => (n - m, m),
+                    1 => (0, n - m),
+                    _ => (m, 0),
+                })
+                .collect(),
+        }
     }
 }
 
@@ -153,5 +201,32 @@ mod tests {
             }
         }
         assert_eq!(idx, lattice_len(n));
+    }
+
+    #[test]
+    fn lattice_parts_cover_the_lattice_once() {
+        for n in 1..=7 {
+            let mut seen = vec![0; lattice_len(n)];
+            for part in [
+                LatticePart::Interior,
+                LatticePart::Edge(0),
+                LatticePart::Edge(1),
+                LatticePart::Edge(2),
+            ] {
+                for (i, j) in part.points(n) {
+                    seen[lattice_index(n, i, j)] += 1;
+                    let l = lattice_bary(n, i, j);
+                    match part {
+                        LatticePart::Edge(k) => assert_eq!(l[k as usize], 0.0),
+                        _ => assert!(l.iter().all(|&x| x > 0.0)),
+                    }
+                }
+            }
+            // Everything but the three corners, once.
+            assert_eq!(seen.iter().filter(|&&c| c == 0).count(), 3);
+            assert!(seen.iter().all(|&c| c <= 1));
+            let all = LatticePart::All.points(n);
+            assert!((0..all.len()).all(|x| lattice_index(n, all[x].0, all[x].1) == x));
+        }
     }
 }

@@ -1,10 +1,30 @@
 //! Everything about a domain point that does not depend on geometry: the Bernstein basis, the
-//! subdomain and the blend weight. Computed per point for [`Surface::evaluate`](super::Surface),
-//! and once per (level, edge widths, profile) for a whole lattice, then reused by every triangle
+//! subdomain and the blend weight, folded into one weight per control point of the two nets a
+//! point combines. Computed per point for [`Surface::evaluate`](super::Surface), and once per
+//! (level, lattice part, edge widths, profile) for a whole lattice, then reused by every triangle
 //! with the same widths.
 //!
 //! It deliberately holds no positions or normals; combining weights with control nets is
 //! `g2.rs`'s job.
+//!
+//! # Why the weights are pre-blended and stored lane by lane
+//!
+//! `S = b_f + β(b_g − b_f)` (Eq. 5, weights swapped back) and its derivatives
+//! `∂S = ∂b_f + β(∂b_g − ∂b_f) + ∂β·(b_g − b_f)` are linear in the two control nets, so with
+//! the Bernstein basis `B_m` of Eq. 1:
+//!
+//! ```text
+//! S   = Σ (1−β)·B_m · f_m            + Σ β·B_m · g_m
+//! ∂S  = Σ ((1−β)·∂B_m − ∂β·B_m) · f_m + Σ (β·∂B_m + ∂β·B_m) · g_m
+//! ```
+//!
+//! Those per-point weights depend on the domain point only, so a pattern stores them instead
+//! of `B`, `β` and `∂β`: a point then costs 9 dot products of length 10 (outside the blending
+//! regions, where the neighbour's weights are all zero) or 20, and no branching. Points are
+//! grouped by the net they blend with and packed [`LANES`] to a [`Lanes`] block, weights
+//! indexed `[quantity][control point][lane]`, so that the sums run over several points at once
+//! in SIMD registers while each point's sum keeps the order of the one-point evaluation: the
+//! lattice and [`Surface::evaluate`](super::Surface) agree bit for bit.
 
 use std::collections::HashMap;
 use std::sync::{Arc, RwLock};
@@ -12,7 +32,63 @@ use std::sync::{Arc, RwLock};
 use super::blend::BlendWeight;
 use super::pn::Bernstein;
 use super::profile::Profile;
-use super::{lattice_bary, lattice_len};
+use super::{lattice_bary, LatticePart};
+
+/// Points evaluated together: two f64 lanes fill an SSE2 register, the baseline of x86-64.
+pub const LANES: usize = 2;
+
+/// Weights of one net for `L` points: `[quantity][control point][lane]`, quantity 0 the
+/// position, 1 and 2 the derivatives `∂_u` and `∂_v` (`∂_u = ∂/∂u − ∂/∂w`, `∂_v = ∂/∂v − ∂/∂w`).
+pub type NetWeights<const L: usize> = [[[f64; L]; 10]; 3];
+
+/// Up to `L` points with their weights on the triangle's own net and, when they blend, on the
+/// neighbour's net across one edge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lanes<const L: usize> {
+    /// Weights on the own net `b_f`.
+    pub own: NetWeights<L>,
+    /// Weights on the neighbour's net `b_g ∘ M` across the edge opposite corner `k` of the
+    /// group; unused (and zero) outside the blending regions.
+    pub across: NetWeights<L>,
+    /// Barycentrics of each point, for the orientation of its normal.
+    pub bary: [[f64; 3]; L],
+    /// Where each point goes in the output; [`Lanes::PADDING`] for unused lanes.
+    pub target: [u32; L],
+}
+
+impl<const L: usize> Lanes<L> {
+    /// Target of an unused lane (its weights are zero).
+    pub const PADDING: u32 = u32::MAX;
+
+    fn empty() -> Self {
+        Lanes {
+            own: [[[0.0; L]; 10]; 3],
+            across: [[[0.0; L]; 10]; 3],
+            bary: [[0.0; 3]; L],
+            target: [Self::PADDING; L],
+        }
+    }
+
+    /// Writes point `w` into lane `lane`, to go to output `target`.
+    fn set(&mut self, lane: usize, w: &PointWeights, target: u32) {
+        for q in 0..3 {
+            for m in 0..10 {
+                self.own[q][m][lane] = w.own[q][m];
+                self.across[q][m][lane] = w.across[q][m];
+            }
+        }
+        self.bary[lane] = w.bary;
+        self.target[lane] = target;
+    }
+
+    /// A single point in lane 0: how [`Surface::evaluate`](super::Surface) runs the lattice's
+    /// code.
+    pub fn single(w: &PointWeights) -> Self {
+        let mut lanes = Self::empty();
+        lanes.set(0, w, 0);
+        lanes
+    }
+}
 
 /// The geometry-free data of one domain point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,10 +97,14 @@ pub struct PointWeights {
     pub bary: [f64; 3],
     /// `Some(c)` when the point is exactly corner `c`.
     pub corner: Option<u8>,
-    /// Bernstein basis and derivatives at `bary`.
-    pub basis: Bernstein,
-    /// Subdomain and blend weight.
-    pub blend: BlendWeight,
+    /// Subdomain: the point blends with the neighbour across the edge opposite corner `k`.
+    pub k: u8,
+    /// Whether it blends at all (`β` or one of its derivatives is not 0).
+    pub blended: bool,
+    /// Weights on the own net, `[quantity][control point]` (see the module documentation).
+    pub own: [[f64; 10]; 3],
+    /// Weights on the neighbour's net; all zero unless `blended`.
+    pub across: [[f64; 10]; 3],
 }
 
 impl PointWeights {
@@ -32,36 +112,88 @@ impl PointWeights {
     pub fn at(bary: [f64; 3], h: [f64; 3], profile: Profile) -> PointWeights {
         let corner = (0..3)
             .find(|&c| bary[c] == 1.0 && bary[(c + 1) % 3] == 0.0 && bary[(c + 2) % 3] == 0.0);
+        let basis = Bernstein::at(bary);
+        let b = BlendWeight::at(bary, h, profile);
+        let blended = b.beta != 0.0 || b.beta_u != 0.0 || b.beta_v != 0.0;
+        let mut own = [basis.value, basis.du, basis.dv];
+        let mut across = [[0.0; 10]; 3];
+        if blended {
+            // The two sums of the module documentation (Eq. 5 with ∂β from Eq. 4).
+            let keep = 1.0 - b.beta;
+            for m in 0..10 {
+                let (v, du, dv) = (basis.value[m], basis.du[m], basis.dv[m]);
+                own[0][m] = keep * v;
+                own[1][m] = keep * du - b.beta_u * v;
+                own[2][m] = keep * dv - b.beta_v * v;
+                across[0][m] = b.beta * v;
+                across[1][m] = b.beta * du + b.beta_u * v;
+                across[2][m] = b.beta * dv + b.beta_v * v;
+            }
+        }
         PointWeights {
             bary,
             corner: corner.map(|c| c as u8),
-            basis: Bernstein::at(bary),
-            blend: BlendWeight::at(bary, h, profile),
+            k: b.k,
+            blended,
+            own,
+            across,
         }
     }
 }
 
-/// The weights of every point of a level-`n` lattice, in lattice order.
+/// The weights of the points of one part of a level-`n` lattice, grouped by the net they
+/// blend with.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pattern {
-    pub points: Vec<PointWeights>,
+    /// Number of points; targets run over `0..len`, in the part's order.
+    pub len: usize,
+    /// Corners in the part: (corner, target). Their point is the input vertex's own.
+    pub corners: Vec<(u8, u32)>,
+    /// Points that blend with no neighbour.
+    pub plain: Vec<Lanes<LANES>>,
+    /// `blended[k]`: points that blend with the neighbour across the edge opposite corner `k`.
+    pub blended: [Vec<Lanes<LANES>>; 3],
 }
 
 impl Pattern {
-    /// Computes the pattern for level `n ≥ 1`.
-    pub fn new(n: u32, h: [f64; 3], profile: Profile) -> Pattern {
-        let mut points = Vec::with_capacity(lattice_len(n));
-        for j in 0..=n {
-            for i in 0..=n - j {
-                points.push(PointWeights::at(lattice_bary(n, i, j), h, profile));
+    /// Computes the pattern of `part` of the level-`n` lattice (`n ≥ 1`).
+    pub fn new(n: u32, part: LatticePart, h: [f64; 3], profile: Profile) -> Pattern {
+        let mut pattern = Pattern {
+            len: 0,
+            corners: Vec::new(),
+            plain: Vec::new(),
+            blended: [Vec::new(), Vec::new(), Vec::new()],
+        };
+        // Lanes filled so far in the last block of each group.
+        let mut filled = [LANES; 4];
+        let points = part.points(n);
+        for (target, &(i, j)) in points.iter().enumerate() {
+            let target = target as u32;
+            let w = PointWeights::at(lattice_bary(n, i, j), h, profile);
+            if let Some(c) = w.corner {
+                pattern.corners.push((c, target));
+                continue;
             }
+            let (group, blocks) = if w.blended {
+                (w.k as usize, &mut pattern.blended[w.k as usize])
+            } else {
+                (3, &mut pattern.plain)
+            };
+            if filled[group] == LANES {
+                blocks.push(Lanes::empty());
+                filled[group] = 0;
+            }
+            let last = blocks.last_mut().expect("a block was just pushed");
+            last.set(filled[group], &w, target);
+            filled[group] += 1;
         }
-        Pattern { points }
+        pattern.len = points.len();
+        pattern
     }
 }
 
-/// Patterns keyed by level, the bit patterns of the three widths, and the profile.
-type Key = (u32, [u64; 3], Profile);
+/// Patterns keyed by level, lattice part, the bit patterns of the three widths, and the profile.
+type Key = (u32, LatticePart, [u64; 3], Profile);
 
 /// A shared, thread-safe store of patterns. Meshes with many distinct width triples would make
 /// it grow without reuse, so past [`PatternCache::MAX_ENTRIES`] new patterns are built but not
@@ -72,16 +204,16 @@ pub struct PatternCache {
 }
 
 impl PatternCache {
-    /// Most patterns kept (a level-16 pattern is about 40 kB).
+    /// Most patterns kept (a whole level-16 lattice is about 80 kB).
     pub const MAX_ENTRIES: usize = 1024;
 
     /// The pattern for this key, built on first use.
-    pub fn get(&self, n: u32, h: [f64; 3], profile: Profile) -> Arc<Pattern> {
-        let key = (n, h.map(f64::to_bits), profile);
+    pub fn get(&self, n: u32, part: LatticePart, h: [f64; 3], profile: Profile) -> Arc<Pattern> {
+        let key = (n, part, h.map(f64::to_bits), profile);
         if let Some(p) = self.map.read().expect("pattern cache lock").get(&key) {
             return Arc::clone(p);
         }
-        let pattern = Arc::new(Pattern::new(n, h, profile));
+        let pattern = Arc::new(Pattern::new(n, part, h, profile));
         let mut map = self.map.write().expect("pattern cache lock");
         if map.len() < Self::MAX_ENTRIES {
             map.entry(key).or_insert_with(|| Arc::clone(&pattern));

@@ -1,5 +1,6 @@
 //! Which part of a source triangle a lattice point lies on: a corner, an edge (and where along
-//! it), or the interior. Pure index arithmetic, shared by the tessellator and its tests.
+//! it), or the interior. Pure index arithmetic; the surface's [`LatticePart`](crate::surface::LatticePart)
+//! lists the points of each part in the orders this numbering assumes (tested below).
 
 /// Where lattice point `(i, j)` of level `n` lies; bary = ((n-i-j)/n, i/n, j/n).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -32,19 +33,16 @@ impl SampleKind {
     }
 }
 
-/// Lattice coordinates `(i, j)` of step `m` along the edge opposite corner `k`, walked from
-/// corner `k+1` to corner `k+2`: the inverse of [`SampleKind::of`] for edges.
-pub(crate) fn edge_sample_coords(n: u32, k: usize, m: u32) -> (u32, u32) {
-    match k {
-        2 => (m, 0),
-        0 => (n - m, m),
-        _ => (0, n - m),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::surface::LatticePart;
+
+    /// Lattice coordinates `(i, j)` of step `m` along the edge opposite corner `k`, walked from
+    /// corner `k+1` to corner `k+2`, as the surface's edge part lists them.
+    fn edge_sample_coords(n: u32, k: usize, m: u32) -> (u32, u32) {
+        LatticePart::Edge(k as u8).points(n)[(m - 1) as usize]
+    }
 
     #[test]
     fn every_lattice_point_is_classified_once() {
@@ -61,7 +59,10 @@ mod tests {
                             assert_eq!(edge_sample_coords(n, k, m), (i, j));
                             edges[k] += 1;
                         }
-                        SampleKind::Interior { index } => interior.push(index),
+                        SampleKind::Interior { index } => {
+                            assert_eq!(LatticePart::Interior.points(n)[index], (i, j));
+                            interior.push(index);
+                        }
                     }
                 }
             }

@@ -27,6 +27,10 @@
 //! Everything that depends on the level alone is planned once (`plan.rs`); the vertex numbering
 //! of a group is index arithmetic on the input triangles (`layout.rs`), so every block of
 //! consecutive source triangles owns a contiguous range of the final vertex and index buffers.
+//! Each output vertex is evaluated once: a corner is the input vertex (no evaluation), the
+//! samples of a welded edge come from one shared pass, positions and normals (a triangle that
+//! owns a split copy of them evaluates only its own normals there), and each triangle evaluates
+//! only its interior ([`LatticePart`]).
 //! Blocks run in parallel (rayon) and write straight into those ranges: no per-vertex
 //! allocation, no hash map, and the same bytes at any thread count. Triangles come out in
 //! cache-friendly bands and vertices in order of first use, so meshoptimizer's passes have
@@ -37,9 +41,8 @@ mod layout;
 mod plan;
 
 use crate::mesh::TriMesh;
-use crate::surface::{Surface, SurfacePoint};
+use crate::surface::{LatticePart, Surface, SurfacePoint};
 use crate::topology::{EdgeId, Topology};
-use lattice_edges::{edge_sample_coords, SampleKind};
 use layout::GroupLayout;
 use plan::LatticePlan;
 use rayon::prelude::*;
@@ -92,55 +95,64 @@ pub fn tessellate(
     groups: &[Range<usize>],
 ) -> Vec<DenseMesh> {
     let plan = LatticePlan::new(level.max(1));
-    let edge_positions = shared_edge_positions(mesh, topo, surface, plan.n);
+    let edge_samples = shared_edge_samples(mesh, topo, surface, plan.n);
     groups
         .par_iter()
-        .map(|range| {
-            tessellate_group(
-                mesh,
-                topo,
-                h,
-                surface,
-                &plan,
-                range.clone(),
-                &edge_positions,
-            )
-        })
+        .map(|range| tessellate_group(mesh, topo, h, surface, &plan, range.clone(), &edge_samples))
         .collect()
 }
 
-/// Samples of every welded edge, `n - 1` per edge in the edge's canonical direction
-/// (`verts[0]` to `verts[1]`), evaluated by the edge's lowest-numbered triangle.
-fn shared_edge_positions(
+/// The samples of every welded edge, `n - 1` per edge in the edge's canonical direction
+/// (`verts[0]` to `verts[1]`), as written to the output.
+struct EdgeSamples {
+    positions: Vec<[f32; 3]>,
+    /// The normals of the evaluating triangle ([`evaluator`]); other triangles that own a copy
+    /// of the samples evaluate their own, which differ across a crease.
+    normals: Vec<[f32; 3]>,
+}
+
+/// The triangle that evaluates the samples of welded edge `e` for everyone, and the corner its
+/// side of the edge is opposite: the edge's lowest-numbered triangle.
+fn evaluator(topo: &Topology, e: usize) -> Option<(usize, usize)> {
+    let &(tri, k) = topo.edges[e].tris.iter().min_by_key(|&&(t, k)| (t.0, k))?;
+    Some((tri.0 as usize, k as usize))
+}
+
+/// Evaluates the samples of every welded edge once, from its [`evaluator`].
+fn shared_edge_samples(
     mesh: &TriMesh,
     topo: &Topology,
     surface: &dyn Surface,
     n: u32,
-) -> Vec<[f32; 3]> {
+) -> EdgeSamples {
     let per_edge = (n - 1) as usize;
-    let mut out = vec![[0.0f32; 3]; topo.edges.len() * per_edge];
+    let mut out = EdgeSamples {
+        positions: vec![[0.0f32; 3]; topo.edges.len() * per_edge],
+        normals: vec![[0.0f32; 3]; topo.edges.len() * per_edge],
+    };
     if per_edge == 0 || mesh.triangles.is_empty() {
         return out;
     }
-    out.par_chunks_mut(per_edge).enumerate().for_each_init(
-        || (Vec::with_capacity(per_edge), Vec::with_capacity(per_edge)),
-        |(points, values): &mut (Vec<(u32, u32)>, Vec<SurfacePoint>), (e, chunk)| {
-            let edge = &topo.edges[e];
-            let Some(&(tri, k)) = edge.tris.iter().min_by_key(|&&(t, k)| (t.0, k)) else {
-                return;
-            };
-            let (tri, k) = (tri.0 as usize, k as usize);
-            points.clear();
-            points.extend((1..n).map(|m| edge_sample_coords(n, k, m)));
-            values.clear();
-            surface.evaluate_lattice_points(tri, n, points, values);
-            let forward = canonical_forward(topo, tri, k);
-            for (m, p) in (1..n).zip(values.iter()) {
-                let slot = if forward { m } else { n - m };
-                chunk[(slot - 1) as usize] = p.position.as_vec3().to_array();
-            }
-        },
-    );
+    out.positions
+        .par_chunks_mut(per_edge)
+        .zip(out.normals.par_chunks_mut(per_edge))
+        .enumerate()
+        .for_each_init(
+            || Vec::with_capacity(per_edge),
+            |values: &mut Vec<SurfacePoint>, (e, (positions, normals))| {
+                let Some((tri, k)) = evaluator(topo, e) else {
+                    return;
+                };
+                values.clear();
+                surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), values);
+                let forward = canonical_forward(topo, tri, k);
+                for (m, p) in (1..n).zip(values.iter()) {
+                    let slot = (if forward { m } else { n - m } - 1) as usize;
+                    positions[slot] = p.position.as_vec3().to_array();
+                    normals[slot] = p.normal.as_vec3().to_array();
+                }
+            },
+        );
     out
 }
 
@@ -175,7 +187,7 @@ struct Shared<'a> {
     surface: &'a dyn Surface,
     plan: &'a LatticePlan,
     layout: &'a GroupLayout,
-    edge_positions: &'a [[f32; 3]],
+    edge_samples: &'a EdgeSamples,
     first_tri: usize,
 }
 
@@ -186,7 +198,7 @@ fn tessellate_group(
     surface: &dyn Surface,
     plan: &LatticePlan,
     range: Range<usize>,
-    edge_positions: &[[f32; 3]],
+    edge_samples: &EdgeSamples,
 ) -> DenseMesh {
     let n = plan.n;
     let layout = GroupLayout::new(mesh, topo, h, n, plan.interior, range.clone());
@@ -239,7 +251,7 @@ fn tessellate_group(
         surface,
         plan,
         layout: &layout,
-        edge_positions,
+        edge_samples,
         first_tri: range.start,
     };
     blocks
@@ -248,78 +260,124 @@ fn tessellate_group(
     out
 }
 
-/// Evaluates and writes the vertices a block owns and all its triangles.
-fn tessellate_block(shared: &Shared<'_>, block: Block<'_>) {
+impl Block<'_> {
+    /// Writes output vertex `slot` (numbered in the whole group).
+    #[inline]
+    fn put(&mut self, slot: usize, position: [f32; 3], normal: [f32; 3], source: VertexSource) {
+        let at = slot - self.vertex_base;
+        self.positions[at] = position;
+        self.normals[at] = normal;
+        self.sources[at] = source;
+    }
+}
+
+/// Evaluates and writes the vertices a block owns and all its triangles. Each output vertex is
+/// evaluated once: corners are the input vertices, edge samples come from the shared pass (their
+/// normals too, unless this triangle is not the edge's evaluator), and only the interior is
+/// evaluated here.
+fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
     let Shared {
         mesh,
         topo,
         surface,
         plan,
         layout,
-        edge_positions,
+        edge_samples,
         first_tri,
     } = *shared;
     let n = plan.n;
     let per_edge = (n - 1) as usize;
     let per_tri_indices = 3 * (n * n) as usize;
-    let mut lattice: Vec<SurfacePoint> = Vec::with_capacity(plan.kinds.len());
-    let mut local = vec![0u32; plan.kinds.len()];
+    let mut interior: Vec<SurfacePoint> = Vec::with_capacity(plan.interior);
+    let mut own_edge: Vec<SurfacePoint> = Vec::with_capacity(per_edge);
+    let mut local = vec![0u32; plan.len];
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
         let corners = mesh.triangles[tri];
         let owns = layout.owns[offset];
-        let interior_base = layout.base[offset + 1] as usize - plan.interior;
-        lattice.clear();
-        surface.evaluate_lattice(tri, n, &mut lattice);
-        for (li, kind) in plan.kinds.iter().enumerate() {
-            let (slot, owned, position) = match *kind {
-                SampleKind::Corner(c) => {
-                    // The vertex's own position, not its welded representative: welding
-                    // equates -0.0 and +0.0, and the input's bits are kept.
-                    let v = corners[c] as usize;
-                    let position = mesh.positions[v].as_vec3().to_array();
-                    (
-                        layout.corner_slot[3 * offset + c] as usize,
-                        owns & (1 << c) != 0,
-                        position,
-                    )
-                }
-                SampleKind::Edge { k, m } => {
-                    let (a, b) = (corners[(k + 1) % 3], corners[(k + 2) % 3]);
-                    // Slot along the input edge, walked from its lower input index.
-                    let slot_m = if a <= b { m } else { n - m };
-                    let slot = layout.edge_slot[3 * offset + k] as usize + (slot_m - 1) as usize;
-                    let owned = owns & (8 << k) != 0;
-                    let position = if owned {
-                        let e = topo.tri_edges[tri][k].0 as usize;
-                        let welded_m = if canonical_forward(topo, tri, k) {
-                            m
-                        } else {
-                            n - m
-                        };
-                        edge_positions[e * per_edge + (welded_m - 1) as usize]
-                    } else {
-                        [0.0; 3]
-                    };
-                    (slot, owned, position)
-                }
-                SampleKind::Interior { .. } => (
-                    interior_base + plan.interior_rank[li] as usize,
-                    true,
-                    lattice[li].position.as_vec3().to_array(),
-                ),
-            };
+        let source = |li: usize| VertexSource {
+            tri: tri as u32,
+            bary: plan.bary[li],
+        };
+
+        for (c, &li) in plan.corners.iter().enumerate() {
+            let li = li as usize;
+            let slot = layout.corner_slot[3 * offset + c] as usize;
             local[li] = slot as u32;
-            if owned {
-                let at = slot - block.vertex_base;
-                block.positions[at] = position;
-                block.normals[at] = lattice[li].normal.as_vec3().to_array();
-                block.sources[at] = VertexSource {
-                    tri: tri as u32,
-                    bary: plan.bary[li],
+            if owns & (1 << c) != 0 {
+                // The vertex's own position, not its welded representative: welding equates
+                // -0.0 and +0.0, and the input's bits are kept. Its normal is the normalized
+                // input normal (the contract of `Surface::evaluate` at a corner); only a
+                // degenerate input normal needs the surface's fallback.
+                let v = corners[c] as usize;
+                let normal = match mesh.normals[v].try_normalize() {
+                    Some(normal) => normal,
+                    None => {
+                        let mut bary = [0.0; 3];
+                        bary[c] = 1.0;
+                        surface.evaluate(tri, bary).normal
+                    }
                 };
+                block.put(
+                    slot,
+                    mesh.positions[v].as_vec3().to_array(),
+                    normal.as_vec3().to_array(),
+                    source(li),
+                );
             }
         }
+
+        for (k, lis) in plan.edges.iter().enumerate() {
+            let (a, b) = (corners[(k + 1) % 3], corners[(k + 2) % 3]);
+            let first = layout.edge_slot[3 * offset + k] as usize;
+            // Slot along the input edge, walked from its lower input index.
+            let slot = |m: u32| first + (if a <= b { m } else { n - m } - 1) as usize;
+            if owns & (8 << k) == 0 {
+                for (m, &li) in (1..n).zip(lis) {
+                    local[li as usize] = slot(m) as u32;
+                }
+                continue;
+            }
+            let e = topo.tri_edges[tri][k].0 as usize;
+            let forward = canonical_forward(topo, tri, k);
+            // Positions always come from the shared pass (bit-watertight); normals too when this
+            // side evaluated it, else from this side's own surface (they differ across creases).
+            let evaluated_here = evaluator(topo, e) == Some((tri, k));
+            if !evaluated_here {
+                own_edge.clear();
+                surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut own_edge);
+            }
+            for (m, &li) in (1..n).zip(lis) {
+                let li = li as usize;
+                let s = slot(m);
+                local[li] = s as u32;
+                let welded = e * per_edge + (if forward { m } else { n - m } - 1) as usize;
+                let normal = if evaluated_here {
+                    edge_samples.normals[welded]
+                } else {
+                    own_edge[(m - 1) as usize].normal.as_vec3().to_array()
+                };
+                block.put(s, edge_samples.positions[welded], normal, source(li));
+            }
+        }
+
+        if plan.interior > 0 {
+            interior.clear();
+            surface.evaluate_lattice_part(tri, n, LatticePart::Interior, &mut interior);
+            let interior_base = layout.base[offset + 1] as usize - plan.interior;
+            for (rank, &(li, index)) in plan.interior_by_rank.iter().enumerate() {
+                let (li, slot) = (li as usize, interior_base + rank);
+                local[li] = slot as u32;
+                let p = &interior[index as usize];
+                block.put(
+                    slot,
+                    p.position.as_vec3().to_array(),
+                    p.normal.as_vec3().to_array(),
+                    source(li),
+                );
+            }
+        }
+
         let start = (offset - block.tris.start) * per_tri_indices;
         let out = &mut block.indices[start..start + per_tri_indices];
         for (dst, t) in out.chunks_exact_mut(3).zip(&plan.triangles) {

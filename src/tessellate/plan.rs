@@ -19,13 +19,19 @@ pub(crate) const BAND: u32 = 7;
 pub(crate) struct LatticePlan {
     /// Segments per edge.
     pub n: u32,
-    /// Kind of each lattice point, in lattice order.
-    pub kinds: Vec<SampleKind>,
+    /// Number of lattice points, `(n + 1)(n + 2)/2`.
+    pub len: usize,
     /// Barycentrics of each lattice point as stored in [`super::VertexSource`].
     pub bary: Vec<[f32; 3]>,
-    /// For interior points, their rank in order of first use by [`LatticePlan::triangles`]
-    /// (the vertex fetch order); `u32::MAX` elsewhere.
-    pub interior_rank: Vec<u32>,
+    /// Lattice index of each corner.
+    pub corners: [u32; 3],
+    /// `edges[k][m − 1]`: lattice index of step `m` along the edge opposite corner `k`, walked
+    /// from corner `k + 1` (the order of [`LatticePart::Edge`](crate::surface::LatticePart)).
+    pub edges: [Vec<u32>; 3],
+    /// Interior points in order of first use by [`LatticePlan::triangles`] (the vertex fetch
+    /// order, which is the order they are numbered in): their lattice index and their index in
+    /// [`LatticePart::Interior`](crate::surface::LatticePart) order.
+    pub interior_by_rank: Vec<(u32, u32)>,
     /// The `n²` sub-triangles as lattice indices, wound like the source triangle, in emission
     /// order.
     pub triangles: Vec<[u32; 3]>,
@@ -46,22 +52,34 @@ impl LatticePlan {
             }
         }
         let triangles = banded_triangles(n);
-        let mut interior_rank = vec![u32::MAX; len];
-        let mut next = 0;
+        let mut corners = [0; 3];
+        let mut edges = [0, 1, 2].map(|_| vec![0; n.saturating_sub(1) as usize]);
+        for (li, kind) in kinds.iter().enumerate() {
+            match *kind {
+                SampleKind::Corner(c) => corners[c] = li as u32,
+                SampleKind::Edge { k, m } => edges[k][(m - 1) as usize] = li as u32,
+                SampleKind::Interior { .. } => {}
+            }
+        }
+        let mut ranked = vec![false; len];
+        let mut interior_by_rank = Vec::new();
         for &li in triangles.iter().flatten() {
-            let li = li as usize;
-            if matches!(kinds[li], SampleKind::Interior { .. }) && interior_rank[li] == u32::MAX {
-                interior_rank[li] = next;
-                next += 1;
+            if let SampleKind::Interior { index } = kinds[li as usize] {
+                if !ranked[li as usize] {
+                    ranked[li as usize] = true;
+                    interior_by_rank.push((li, index as u32));
+                }
             }
         }
         LatticePlan {
             n,
-            kinds,
+            len,
             bary,
-            interior_rank,
+            corners,
+            edges,
+            interior: interior_by_rank.len(),
+            interior_by_rank,
             triangles,
-            interior: next as usize,
         }
     }
 }
