@@ -6,6 +6,7 @@
 //! rules themselves live in [`crate::attributes`] and [`crate::tangents`].
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::morph::TargetSurface;
 use crate::attributes::{self, Carry, FloatAttribute, Skin, SourceTriangles};
@@ -348,17 +349,21 @@ fn keep_exact_corner_normals(prep: &Prepared, dense: &mut DenseMesh, tris: Sourc
     let Some(exact) = &prep.exact_normals else {
         return;
     };
-    for (n, s) in dense.normals.iter_mut().zip(&dense.sources) {
-        let Some(c) = s.bary.iter().position(|&b| b == 1.0) else {
-            continue;
-        };
-        let v = tris.triangles[(s.tri - tris.first_tri) as usize][c] as usize;
-        let e = exact[v];
-        let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-        if (len - 1.0).abs() < 1e-6 {
-            *n = e;
-        }
-    }
+    dense
+        .normals
+        .par_iter_mut()
+        .zip(&dense.sources)
+        .for_each(|(n, s)| {
+            let Some(c) = s.bary.iter().position(|&b| b == 1.0) else {
+                return;
+            };
+            let v = tris.triangles[(s.tri - tris.first_tri) as usize][c] as usize;
+            let e = exact[v];
+            let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+            if (len - 1.0).abs() < 1e-6 {
+                *n = e;
+            }
+        });
 }
 
 /// One morph target of the output: POSITION and NORMAL deltas from the re-evaluated surface,
