@@ -11,6 +11,8 @@
 
 use std::ops::Range;
 
+use rayon::slice::ParallelSliceMut as _;
+
 use crate::mesh::TriMesh;
 use crate::topology::Topology;
 
@@ -115,7 +117,8 @@ fn first_use_of_each_input_edge(
             keys.push((lo, hi, side, half));
         }
     }
-    keys.sort_unstable();
+    // Keys are distinct (each holds its half-edge), so the parallel sort's order is the order.
+    keys.par_sort_unstable();
     let mut first = vec![0u32; keys.len()];
     let mut run_start = 0;
     for i in 0..keys.len() {
