@@ -62,3 +62,20 @@ impl<K, P> fmt::Debug for LatticeCache<K, P> {
             .finish()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keeps_entries_up_to_its_bound_then_builds_nothing() {
+        let cache: LatticeCache<u32, u32> = LatticeCache::new(2);
+        assert_eq!(cache.get_or_build(1, || 10).as_deref(), Some(&10));
+        assert_eq!(cache.get_or_build(2, || 20).as_deref(), Some(&20));
+        // Kept: not rebuilt.
+        assert_eq!(cache.get_or_build(1, || 99).as_deref(), Some(&10));
+        // Full: the caller computes directly.
+        assert_eq!(cache.get_or_build(3, || 30), None);
+        assert_eq!(cache.clone().get_or_build(3, || 30).as_deref(), Some(&30));
+    }
+}
