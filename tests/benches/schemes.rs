@@ -2,8 +2,10 @@
 //! analytic and with finite-difference normals, Coons over Foley–Opitz edge surfaces), and the
 //! cost of building each surface.
 //!
-//! The mesh is the 320-triangle bumpy sphere of the tests, evaluated point by point on the
-//! level-16 lattice of every triangle (153 points per triangle, 48 960 per pass).
+//! The mesh is the 320-triangle bumpy sphere of the tests, evaluated on the level-16 lattice of
+//! every triangle (153 points per triangle, 48 960 per pass): point by point through
+//! `evaluate`, and whole lattices through `evaluate_lattice` as the tessellator does (Coons also
+//! with per-triangle faired λ, where lattice weights are not shared).
 
 #[path = "../support/mod.rs"]
 mod support;
@@ -31,6 +33,7 @@ fn bench(c: &mut Criterion) {
         ..d
     };
     let coons = CoonsSurface::new(&mesh, &topo, &h, &pnavg);
+    let faired = SchemeParams { fair: true, ..fo };
     let surfaces: Vec<(&str, Box<dyn Surface>)> = vec![
         ("pn", build_surface(Scheme::Pn, &mesh, &topo, &h, &d).0),
         (
@@ -50,6 +53,10 @@ fn bench(c: &mut Criterion) {
             "coons_fo",
             build_surface(Scheme::Coons, &mesh, &topo, &h, &fo).0,
         ),
+        (
+            "coons_fo_faired",
+            build_surface(Scheme::Coons, &mesh, &topo, &h, &faired).0,
+        ),
     ];
 
     let points = mesh.triangles.len() * lattice_len(LEVEL);
@@ -66,6 +73,18 @@ fn bench(c: &mut Criterion) {
                             black_box(s.evaluate(t, lattice_bary(LEVEL, i, j)));
                         }
                     }
+                }
+            })
+        });
+    }
+    for (name, s) in &surfaces {
+        let mut out = Vec::with_capacity(lattice_len(LEVEL));
+        group.bench_function(BenchmarkId::new("lattice", name), |b| {
+            b.iter(|| {
+                for t in 0..mesh.triangles.len() {
+                    out.clear();
+                    s.evaluate_lattice(t, LEVEL, &mut out);
+                    black_box(&out);
                 }
             })
         });

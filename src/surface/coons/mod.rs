@@ -30,9 +30,20 @@
 //!
 //! Normals: exact, by forward differentiation of the patch formula ([`dual`]), including the
 //! directional derivatives inside its correction term (a dual of a dual). Central differences
-//! ([`NormalMethod::FiniteDifference`]) agree to 1.7e-7° but cost more: per point with its normal
-//! on the bumpy sphere (`benches/schemes.rs`), 1.4 µs analytic against 2.7 µs by differences
-//! (PN: 0.13 µs), so analytic is the default.
+//! ([`NormalMethod::FiniteDifference`]) agree to 1.7e-7° but cost more, so analytic is the
+//! default.
+//!
+//! Speed: Eq. 11 is linear in the 30 control points of the three constituents, with
+//! coefficients that depend only on the domain point, λ and the reading of Definition 2
+//! ([`weights`]). A lattice's coefficients, with their derivatives, are computed once per
+//! (level, λ, definition) in canonical corner order and shared by every triangle with that λ;
+//! a point then costs 90 vector multiply-adds. λ is one value for the whole mesh unless faired;
+//! faired λ are mostly unique, and a triangle whose λ no other triangle has computes its
+//! coefficients point by point. `evaluate` computes the same coefficients at its point and goes
+//! through the same combination, so lattice and `evaluate` agree bit for bit
+//! (`tests/schemes_lattice.rs`). Per point with its normal (`benches/schemes.rs`, bumpy sphere,
+//! level 16): 0.17 µs on a lattice with one λ, 0.4 µs with faired λ, 1.1 µs alone (before the
+//! coefficients were shared, every point cost 1.3 µs; PN: 0.07–0.09 µs).
 //!
 //! Measured (`tests/schemes_continuity.rs`): gap ≤ 3e-15 L and normal jump ≤ 7e-13° across
 //! every smooth edge of the generated meshes (analytic normals; 2e-6° by differences).
@@ -40,18 +51,23 @@
 pub mod dual;
 pub mod fair;
 pub mod patch;
+pub mod weights;
+
+use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::DVec3;
 
+use super::hybrid::lattice::LatticeCache;
 use super::hybrid::{EdgeNets, PaperReading};
 use super::pn::{compose, Net, IJK};
 use super::scheme::creases::{own_nets, smooth_edges, Corners};
 use super::scheme::{SchemeParams, Warning};
-use super::{blend, Surface, SurfacePoint};
+use super::{blend, lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::topology::Topology;
-use dual::Dual;
 use patch::Definition2;
+use weights::Weights;
 
 /// The edge surfaces a Coons patch blends.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -86,15 +102,34 @@ pub struct CoonsSurface {
     lambda: Vec<[f64; 3]>,
     smooth: Vec<bool>,
     warnings: Vec<Warning>,
+    /// Whether another triangle has the same `λ`, so that lattice weights are worth keeping.
+    shared_lambda: Vec<bool>,
     normals: NormalMethod,
     definition: Definition2,
+    /// Lattice weights per (level, bits of λ, definition), in canonical lattice order.
+    patterns: LatticeCache<PatternKey, Vec<LatticePoint>>,
 }
+
+type PatternKey = (u32, [u64; 3], Definition2);
+
+/// One point of a lattice in canonical barycentrics `x`, with its weights.
+#[derive(Debug, Clone, Copy)]
+struct LatticePoint {
+    x: [f64; 3],
+    weights: Weights,
+}
+
+/// `∂_u` and `∂_v` of the input barycentrics `(u, v, w)`, as changes of `(u, v, w)`.
+const SEED: [[f64; 2]; 3] = [[1.0, 0.0], [0.0, 1.0], [-1.0, -1.0]];
 
 impl CoonsSurface {
     /// λ is clamped to this range: towards 0 or 1, μ becomes discontinuous at a corner.
     pub const LAMBDA_RANGE: (f64, f64) = (0.05, 0.95);
     /// The range searched by fairing (see [`fair`]).
     pub const FAIR_RANGE: (f64, f64) = (0.25, 0.75);
+    /// Most lattice weight sets kept (one for the default λ; a level-16 lattice takes about
+    /// 110 kB). Faired λ are mostly unique per triangle, and those are computed point by point.
+    const MAX_PATTERNS: usize = 32;
 
     /// Builds the surface: edges with `h > 0` are G¹, edges with `h = 0` creases (see the module
     /// docs); `h_per_edge` has one entry per welded edge of `topo`. Reads `params.lambda`,
@@ -133,6 +168,14 @@ impl CoonsSurface {
         } else {
             vec![[start; 3]; nets.len()]
         };
+        let mut uses: HashMap<[u64; 3], usize> = HashMap::new();
+        for l in &lambda {
+            *uses.entry(l.map(f64::to_bits)).or_default() += 1;
+        }
+        let shared_lambda = lambda
+            .iter()
+            .map(|l| uses[&l.map(f64::to_bits)] > 1)
+            .collect();
         CoonsSurface {
             corners,
             perm,
@@ -140,8 +183,10 @@ impl CoonsSurface {
             lambda,
             smooth,
             warnings,
+            shared_lambda,
             normals: NormalMethod::default(),
             definition: Definition2::Corrected,
+            patterns: LatticeCache::new(Self::MAX_PATTERNS),
         }
     }
 
@@ -177,10 +222,75 @@ impl CoonsSurface {
         &self.warnings
     }
 
+    /// The position alone, as the finite-difference normals need it; equal to the analytic
+    /// path's position bit for bit ([`weights::position`]).
     fn position(&self, tri: usize, l: [f64; 3]) -> DVec3 {
         let x = self.perm[tri].map(|c| l[c]);
-        let f = patch::point(&self.nets[tri], self.lambda[tri], x, self.definition);
-        DVec3::from_array(f)
+        weights::position(self.lambda[tri], x, self.definition, &self.nets[tri])
+    }
+
+    /// The lattice weights for triangle `tri`'s λ, when they are worth keeping and there is
+    /// room; `None` means evaluate point by point (same values).
+    fn pattern(&self, tri: usize, level: u32) -> Option<Arc<Vec<LatticePoint>>> {
+        if self.normals != NormalMethod::Analytic || !self.shared_lambda[tri] {
+            return None;
+        }
+        let lambda = self.lambda[tri];
+        let key = (level, lambda.map(f64::to_bits), self.definition);
+        self.patterns.get_or_build(key, || {
+            let mut points = Vec::with_capacity(lattice_len(level));
+            for j in 0..=level {
+                for i in 0..=level - j {
+                    let x = lattice_bary(level, i, j);
+                    points.push(LatticePoint {
+                        x,
+                        weights: Weights::at(lambda, x, self.definition),
+                    });
+                }
+            }
+            points
+        })
+    }
+
+    /// Lattice point `(i, j)` of triangle `tri` from the canonical-order `pattern`: the same
+    /// point and weights as [`Surface::evaluate`] computes there, since a lattice point in
+    /// canonical order is another point of the same lattice with the same coordinates.
+    #[inline]
+    fn lattice_point(
+        &self,
+        tri: usize,
+        level: u32,
+        pattern: &[LatticePoint],
+        i: u32,
+        j: u32,
+    ) -> SurfacePoint {
+        let perm = self.perm[tri];
+        let e = [level - i - j, i, j];
+        let p = &pattern[lattice_index(level, e[perm[1]], e[perm[2]])];
+        let mut l = [0.0; 3];
+        for c in 0..3 {
+            l[perm[c]] = p.x[c];
+        }
+        self.analytic(tri, l, &p.weights)
+    }
+
+    /// The surface point of triangle `tri` at input barycentrics `l` with the weights of its
+    /// canonical barycentrics: the one analytic path of both `evaluate` and the lattice.
+    #[inline]
+    fn analytic(&self, tri: usize, l: [f64; 3], w: &Weights) -> SurfacePoint {
+        let corners = &self.corners[tri];
+        if let Some(p) = corners.at_corner(l) {
+            return p;
+        }
+        let [position, d0, d1] = w.combine(&self.nets[tri]);
+        // The input directions in canonical barycentrics, as sums of ±∂_0 and ±∂_1.
+        let s = self.perm[tri].map(|c| SEED[c]);
+        let du = s[0][0] * d0 + s[1][0] * d1;
+        let dv = s[0][1] * d0 + s[1][1] * d1;
+        SurfacePoint {
+            position,
+            normal: corners.orient(l, du, dv),
+        }
     }
 }
 
@@ -247,33 +357,51 @@ impl Surface for CoonsSurface {
         if let Some(p) = corners.at_corner(l) {
             return p;
         }
-        let (position, du, dv) = match self.normals {
+        match self.normals {
             NormalMethod::Analytic => {
-                // ∂_u and ∂_v of the input barycentrics, seeded into the canonical ones.
-                const SEED: [[f64; 2]; 3] = [[1.0, 0.0], [0.0, 1.0], [-1.0, -1.0]];
-                let x = self.perm[tri].map(|c| Dual::new(l[c], SEED[c]));
-                let f = patch::point(&self.nets[tri], self.lambda[tri], x, self.definition);
-                (
-                    DVec3::new(f[0].v, f[1].v, f[2].v),
-                    DVec3::new(f[0].d[0], f[1].d[0], f[2].d[0]),
-                    DVec3::new(f[0].d[1], f[1].d[1], f[2].d[1]),
-                )
+                let x = self.perm[tri].map(|c| l[c]);
+                let w = Weights::at(self.lambda[tri], x, self.definition);
+                self.analytic(tri, l, &w)
             }
             NormalMethod::FiniteDifference => {
                 // The patch varies on the scale of the distance to the nearest corner.
                 let rho = 1.0 - l[0].max(l[1]).max(l[2]);
                 let e = (1e-3 * rho).min(1e-5);
                 let at = |a: f64, b: f64| self.position(tri, [l[0] + a, l[1] + b, l[2] - a - b]);
-                (
-                    self.position(tri, l),
-                    (at(e, 0.0) - at(-e, 0.0)) / (2.0 * e),
-                    (at(0.0, e) - at(0.0, -e)) / (2.0 * e),
-                )
+                let du = (at(e, 0.0) - at(-e, 0.0)) / (2.0 * e);
+                let dv = (at(0.0, e) - at(0.0, -e)) / (2.0 * e);
+                SurfacePoint {
+                    position: self.position(tri, l),
+                    normal: corners.orient(l, du, dv),
+                }
             }
-        };
-        SurfacePoint {
-            position,
-            normal: corners.orient(l, du, dv),
         }
+    }
+
+    fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
+        out.reserve(lattice_len(level));
+        let pattern = self.pattern(tri, level);
+        for j in 0..=level {
+            for i in 0..=level - j {
+                out.push(match &pattern {
+                    Some(p) => self.lattice_point(tri, level, p, i, j),
+                    None => self.evaluate(tri, lattice_bary(level, i, j)),
+                });
+            }
+        }
+    }
+
+    fn evaluate_lattice_points(
+        &self,
+        tri: usize,
+        level: u32,
+        points: &[(u32, u32)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let pattern = self.pattern(tri, level);
+        out.extend(points.iter().map(|&(i, j)| match &pattern {
+            Some(p) => self.lattice_point(tri, level, p, i, j),
+            None => self.evaluate(tri, lattice_bary(level, i, j)),
+        }));
     }
 }

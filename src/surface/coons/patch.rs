@@ -43,7 +43,7 @@ pub type V3<T> = [T; 3];
 
 /// How to read seed 002's Definition 2. Only [`Definition2::Corrected`] is C¹; the printed
 /// readings exist so that tests can show each correction is needed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Definition2 {
     #[default]
     Corrected,
@@ -80,10 +80,23 @@ pub fn point<T: Num>(r: &[Net; 3], lambda: [f64; 3], x: V3<T>, def: Definition2)
 
 /// The cubic Bézier triangle with net `net` at `x`.
 #[inline]
-pub fn cubic<T: Num>(net: &Net, [u, v, w]: V3<T>) -> V3<T> {
+pub fn cubic<T: Num>(net: &Net, x: V3<T>) -> V3<T> {
+    let b = bernstein(x);
+    let mut out = [T::cst(0.0); 3];
+    for (bm, p) in b.iter().zip(net) {
+        out[0] = out[0] + bm.scale(p.x);
+        out[1] = out[1] + bm.scale(p.y);
+        out[2] = out[2] + bm.scale(p.z);
+    }
+    out
+}
+
+/// The cubic Bernstein basis at `x`, in `pn::IJK` order:
+/// b300 b030 b003 b210 b120 b021 b012 b102 b201 b111.
+#[inline]
+pub fn bernstein<T: Num>([u, v, w]: V3<T>) -> [T; 10] {
     let (u2, v2, w2) = (u * u, v * v, w * w);
-    // Bernstein basis in pn::IJK order: b300 b030 b003 b210 b120 b021 b012 b102 b201 b111.
-    let b = [
+    [
         u2 * u,
         v2 * v,
         w2 * w,
@@ -94,19 +107,12 @@ pub fn cubic<T: Num>(net: &Net, [u, v, w]: V3<T>) -> V3<T> {
         (u * w2).scale(3.0),
         (u2 * w).scale(3.0),
         (u * v * w).scale(6.0),
-    ];
-    let mut out = [T::cst(0.0); 3];
-    for (bm, p) in b.iter().zip(net) {
-        out[0] = out[0] + bm.scale(p.x);
-        out[1] = out[1] + bm.scale(p.y);
-        out[2] = out[2] + bm.scale(p.z);
-    }
-    out
+    ]
 }
 
 /// `μ = (1−λ)b² / (λa² + (1−λ)b²)`, the shape of every `μ_k`.
 #[inline]
-fn mu<T: Num>(lambda: f64, a: T, b: T) -> T {
+pub(super) fn mu<T: Num>(lambda: f64, a: T, b: T) -> T {
     let bb = (b * b).scale(1.0 - lambda);
     bb / ((a * a).scale(lambda) + bb)
 }

@@ -23,11 +23,20 @@
 //! schemes, each side keeps its own tangent planes, and the join is G0. For split normals on a
 //! smooth edge both sides use the mean of their end normals for that edge.
 //!
-//! Measured (`tests/schemes_continuity.rs`, `tests/schemes_shape.rs`): gap ≤ 2e-15 L and normal
-//! jump ≤ 4e-13° across every smooth edge of the generated meshes; 0.21 µs per point with its
-//! normal (PN: 0.13 µs); distance to the exact sphere sampled by an icosahedron 0.0131 (PN 0.0584).
+//! Speed: the patch is linear in the nets with coefficients that depend on the domain point only
+//! (Bernstein values, Eq. 2's `h_ij` and Eq. 1's Nielson weights, and their derivatives), so a
+//! lattice's coefficients are computed once per level ([`patch::Weights`]) and every triangle
+//! combines them with its 18 distinct control points: 54 vector multiply-adds per point.
+//! `evaluate` computes the same coefficients at its point and goes through the same combination,
+//! so lattice and `evaluate` agree bit for bit (`tests/schemes_lattice.rs`).
+//!
+//! Measured (`tests/schemes_continuity.rs`, `tests/schemes_shape.rs`, `benches/schemes.rs`): gap
+//! ≤ 2e-15 L and normal jump ≤ 4e-13° across every smooth edge of the generated meshes; per
+//! point with its normal 0.09 µs on a lattice (PN 0.07–0.09 µs) and 0.16 µs alone, as before;
+//! distance to the exact sphere sampled by an icosahedron 0.0131 (PN 0.0584).
 
 pub mod foley_opitz;
+pub mod lattice;
 pub mod patch;
 pub mod plane;
 
@@ -36,11 +45,12 @@ use glam::DVec3;
 use super::pn::{Net, B111, NEAR};
 use super::scheme::creases::{edge_end_normal, own_nets, smooth_edges, Corners};
 use super::scheme::Warning;
-use super::{Surface, SurfacePoint};
+use super::{lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeId, Topology};
 use foley_opitz::{apex_barycentrics, interior_point, neighbour_interior, Labelled};
-use patch::BoundaryBlend;
+use lattice::LatticeCache;
+use patch::{BoundaryBlend, Weights, TERMS};
 
 /// How to read seed 001's formulas. Only [`PaperReading::Corrected`] is a valid surface; the
 /// printed readings exist so that tests can show each correction is needed.
@@ -238,10 +248,24 @@ fn boundary_net(position: [DVec3; 3], normal: [DVec3; 3], m: DVec3) -> Net {
 #[derive(Debug, Clone)]
 pub struct HybridSurface {
     nets: EdgeNets,
-    blend: BoundaryBlend,
+    /// Per triangle, the control points its [`Weights`] combine ([`patch::gather`]).
+    terms: Vec<[DVec3; TERMS]>,
+    /// Per level, the weights of every lattice point, in lattice order.
+    patterns: LatticeCache<u32, Vec<LatticePoint>>,
+}
+
+/// One lattice point: its barycentrics (for the corner test and the normal's orientation) and
+/// its weights.
+#[derive(Debug, Clone, Copy)]
+struct LatticePoint {
+    bary: [f64; 3],
+    weights: Weights,
 }
 
 impl HybridSurface {
+    /// Most levels whose weights are kept (a level-16 lattice takes about 70 kB).
+    const MAX_PATTERNS: usize = 64;
+
     /// Builds the surface: edges with `h > 0` are G¹, edges with `h = 0` creases (see the
     /// module docs); `h_per_edge` has one entry per welded edge of `topo`.
     ///
@@ -262,9 +286,12 @@ impl HybridSurface {
             PaperReading::PrintedStrayK => BoundaryBlend::PrintedStrayK,
             _ => BoundaryBlend::Corrected,
         };
+        let nets = EdgeNets::new(mesh, topo, h_per_edge, reading);
+        let terms = nets.nets.iter().map(|n| patch::gather(n, blend)).collect();
         HybridSurface {
-            nets: EdgeNets::new(mesh, topo, h_per_edge, reading),
-            blend,
+            nets,
+            terms,
+            patterns: LatticeCache::new(Self::MAX_PATTERNS),
         }
     }
 
@@ -277,18 +304,83 @@ impl HybridSurface {
     pub fn warnings(&self) -> &[Warning] {
         &self.nets.warnings
     }
+
+    /// The weights of every point of the level-`level` lattice, built on first use.
+    fn pattern(&self, level: u32) -> Option<std::sync::Arc<Vec<LatticePoint>>> {
+        self.patterns.get_or_build(level, || {
+            let mut points = Vec::with_capacity(lattice_len(level));
+            for j in 0..=level {
+                for i in 0..=level - j {
+                    let bary = lattice_bary(level, i, j);
+                    points.push(LatticePoint {
+                        bary,
+                        weights: patch::weights(bary),
+                    });
+                }
+            }
+            points
+        })
+    }
+
+    /// The surface point of triangle `tri` at barycentrics `l` with weights `w` computed there:
+    /// the one path of both [`Surface::evaluate`] and the lattice.
+    #[inline]
+    fn combine(&self, tri: usize, l: [f64; 3], w: &Weights) -> SurfacePoint {
+        let corners = &self.nets.corners[tri];
+        if let Some(p) = corners.at_corner(l) {
+            return p;
+        }
+        let [position, du, dv] = patch::combine(w, &self.terms[tri]);
+        SurfacePoint {
+            position,
+            normal: corners.orient(l, du, dv),
+        }
+    }
 }
 
 impl Surface for HybridSurface {
     fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
-        let corners = &self.nets.corners[tri];
-        if let Some(p) = corners.at_corner(bary) {
+        if let Some(p) = self.nets.corners[tri].at_corner(bary) {
             return p;
         }
-        let [position, du, dv] = patch::evaluate(&self.nets.nets[tri], bary, self.blend);
-        SurfacePoint {
-            position,
-            normal: corners.orient(bary, du, dv),
+        self.combine(tri, bary, &patch::weights(bary))
+    }
+
+    fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
+        match self.pattern(level) {
+            Some(pattern) => out.extend(
+                pattern
+                    .iter()
+                    .map(|p| self.combine(tri, p.bary, &p.weights)),
+            ),
+            None => {
+                out.reserve(lattice_len(level));
+                for j in 0..=level {
+                    for i in 0..=level - j {
+                        out.push(self.evaluate(tri, lattice_bary(level, i, j)));
+                    }
+                }
+            }
+        }
+    }
+
+    fn evaluate_lattice_points(
+        &self,
+        tri: usize,
+        level: u32,
+        points: &[(u32, u32)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        match self.pattern(level) {
+            Some(pattern) => out.extend(points.iter().map(|&(i, j)| {
+                let p = &pattern[lattice_index(level, i, j)];
+                self.combine(tri, p.bary, &p.weights)
+            })),
+            None => out.extend(
+                points
+                    .iter()
+                    .map(|&(i, j)| self.evaluate(tri, lattice_bary(level, i, j))),
+            ),
         }
     }
 }

@@ -31,10 +31,45 @@ pub enum BoundaryBlend {
     PrintedStrayK,
 }
 
-/// Position and its derivatives along `∂_u = ∂/∂u − ∂/∂w` and `∂_v = ∂/∂v − ∂/∂w` (the
-/// convention of [`Bernstein`]) at barycentrics `l`, which must not be a corner.
-pub fn evaluate(nets: &[Net; 3], l: [f64; 3], blend: BoundaryBlend) -> [DVec3; 3] {
+/// How many control points one patch combines: the three corners, both candidates for each of
+/// the six edge points (`b_{·,i}` and `b_{·,j}` of the boundary blend), and the three nets'
+/// `b111`.
+pub const TERMS: usize = 18;
+
+/// The edge points in term order, as `(k, j)`: exponent 2 at corner k, 1 at j, 0 at `i = 3−j−k`.
+const EDGE_SLOTS: [(usize, usize); 6] = [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)];
+
+/// The patch at one domain point as coefficients on the [`TERMS`] control points [`gather`]
+/// lists: `F = Σ value[n] p[n]`, `∂_u F = Σ du[n] p[n]`, `∂_v F = Σ dv[n] p[n]`.
+///
+/// `F(u) = Σ B_ijk(u) c_ijk(u)` with every `c_ijk` an affine combination of control points whose
+/// weights depend on `u` only (Eq. 1–2), so `F` is linear in the nets with geometry-free
+/// coefficients. They are computed once per lattice point and level and shared by every
+/// triangle; a single point computes the same ones, so both paths agree bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Weights {
+    pub value: [f64; TERMS],
+    pub du: [f64; TERMS],
+    pub dv: [f64; TERMS],
+}
+
+/// The coefficients of [`Weights`] at barycentrics `l`. At a corner they are finite but
+/// meaningless (the blends are 0/0 there); callers return the corner itself instead.
+pub fn weights(l: [f64; 3]) -> Weights {
     let basis = Bernstein::at(l);
+    let grad_to_uv = |g: [f64; 3]| (g[0] - g[2], g[1] - g[2]);
+    let mut w = Weights {
+        value: [0.0; TERMS],
+        du: [0.0; TERMS],
+        dv: [0.0; TERMS],
+    };
+    // Corners are constants: only their Bernstein factor varies.
+    for (k, near) in NEAR.iter().enumerate() {
+        let slot = near[k];
+        w.value[k] = basis.value[slot];
+        w.du[k] = basis.du[slot];
+        w.dv[k] = basis.dv[slot];
+    }
     // h[i][j] = h_ij with its gradient (in the three barycentrics); h_ji = 1 − h_ij.
     let mut h = [[(0.0, [0.0; 3]); 3]; 3];
     for (i, j) in [(0, 1), (0, 2), (1, 2)] {
@@ -42,44 +77,74 @@ pub fn evaluate(nets: &[Net; 3], l: [f64; 3], blend: BoundaryBlend) -> [DVec3; 3
         h[i][j] = (v, g);
         h[j][i] = (1.0 - v, g.map(|x| -x));
     }
-    let grad_to_uv = |g: [f64; 3]| (g[0] - g[2], g[1] - g[2]);
-
-    let mut out = [DVec3::ZERO; 3];
-    let mut add = |slot: usize, c: DVec3, cu: DVec3, cv: DVec3| {
-        out[0] += basis.value[slot] * c;
-        out[1] += basis.du[slot] * c + basis.value[slot] * cu;
-        out[2] += basis.dv[slot] * c + basis.value[slot] * cv;
-    };
-    for k in 0..3 {
-        // Corners are constants.
-        let slot = NEAR[k][k];
-        add(slot, nets[0][slot], DVec3::ZERO, DVec3::ZERO);
-        for j in (0..3).filter(|&j| j != k) {
-            // Exponent 2 at k, 1 at j, 0 at i.
-            let i = 3 - j - k;
-            let slot = NEAR[k][j];
-            let (w, g) = h[i][j];
-            let other = match blend {
-                BoundaryBlend::Corrected => nets[j][slot],
-                BoundaryBlend::PrintedStrayK => nets[k][slot],
-            };
-            let diff = nets[i][slot] - other;
-            let (gu, gv) = grad_to_uv(g);
-            add(slot, other + w * diff, gu * diff, gv * diff);
-        }
+    // c = h_ij b_{·,i} + h_ji b_{·,j} (Eq. 2, corrected):
+    // ∂(B c) = (∂B) c + B (∂h_ij)(b_{·,i} − b_{·,j}).
+    for (e, &(k, j)) in EDGE_SLOTS.iter().enumerate() {
+        let i = 3 - j - k;
+        let slot = NEAR[k][j];
+        let (hij, g) = h[i][j];
+        let hji = h[j][i].0;
+        let (gu, gv) = grad_to_uv(g);
+        let (b, bu, bv) = (basis.value[slot], basis.du[slot], basis.dv[slot]);
+        let (own, other) = (3 + 2 * e, 4 + 2 * e);
+        w.value[own] = b * hij;
+        w.value[other] = b * hji;
+        w.du[own] = bu * hij + b * gu;
+        w.du[other] = bu * hji - b * gu;
+        w.dv[own] = bv * hij + b * gv;
+        w.dv[other] = bv * hji - b * gv;
     }
+    // c111 = Σ a_i b_{111,i} (Eq. 1).
     let (a, ga) = nielson(l);
-    let mut c = DVec3::ZERO;
-    let (mut cu, mut cv) = (DVec3::ZERO, DVec3::ZERO);
+    let (b, bu, bv) = (basis.value[B111], basis.du[B111], basis.dv[B111]);
     for i in 0..3 {
-        let p = nets[i][B111];
         let (gu, gv) = grad_to_uv(ga[i]);
-        c += a[i] * p;
-        cu += gu * p;
-        cv += gv * p;
+        w.value[15 + i] = b * a[i];
+        w.du[15 + i] = bu * a[i] + b * gu;
+        w.dv[15 + i] = bv * a[i] + b * gv;
     }
-    add(B111, c, cu, cv);
+    w
+}
+
+/// The [`TERMS`] control points of one triangle's three nets that [`Weights`] combine, in term
+/// order: corners (from net 0; all three nets share them), then per edge point of
+/// `EDGE_SLOTS` the one of net i and the one `blend` pairs it with, then the three `b111`.
+pub fn gather(nets: &[Net; 3], blend: BoundaryBlend) -> [DVec3; TERMS] {
+    let mut p = [DVec3::ZERO; TERMS];
+    for k in 0..3 {
+        p[k] = nets[0][NEAR[k][k]];
+    }
+    for (e, &(k, j)) in EDGE_SLOTS.iter().enumerate() {
+        let i = 3 - j - k;
+        let slot = NEAR[k][j];
+        p[3 + 2 * e] = nets[i][slot];
+        p[4 + 2 * e] = match blend {
+            BoundaryBlend::Corrected => nets[j][slot],
+            BoundaryBlend::PrintedStrayK => nets[k][slot],
+        };
+    }
+    for i in 0..3 {
+        p[15 + i] = nets[i][B111];
+    }
+    p
+}
+
+/// Position and its `∂_u`, `∂_v` derivatives from weights and gathered control points.
+#[inline]
+pub fn combine(w: &Weights, p: &[DVec3; TERMS]) -> [DVec3; 3] {
+    let mut out = [DVec3::ZERO; 3];
+    for (n, p) in p.iter().enumerate() {
+        out[0] += w.value[n] * *p;
+        out[1] += w.du[n] * *p;
+        out[2] += w.dv[n] * *p;
+    }
     out
+}
+
+/// Position and its derivatives along `∂_u = ∂/∂u − ∂/∂w` and `∂_v = ∂/∂v − ∂/∂w` (the
+/// convention of [`Bernstein`]) at barycentrics `l`, which must not be a corner.
+pub fn evaluate(nets: &[Net; 3], l: [f64; 3], blend: BoundaryBlend) -> [DVec3; 3] {
+    combine(&weights(l), &gather(nets, blend))
 }
 
 /// Seed 001 Eq. 2, `h_ij(u)`, and its gradient. It is 0/0 only at corner k, where every point
