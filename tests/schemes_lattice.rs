@@ -1,5 +1,6 @@
 //! The hybrid and Coons schemes' lattice paths (weights computed once per lattice and shared by
-//! triangles) give exactly what `evaluate` gives at the same points, bit for bit, whatever the
+//! triangles; whole lattices, scattered points and the parts the tessellator asks for) give
+//! exactly what `evaluate` gives at the same points, bit for bit, whatever the
 //! corner order, reading of the papers, shape parameters or normal method.
 
 mod support;
@@ -8,7 +9,7 @@ use g2tess::mesh::TriMesh;
 use g2tess::surface::coons::patch::Definition2;
 use g2tess::surface::coons::{Constituents, CoonsSurface, NormalMethod};
 use g2tess::surface::hybrid::{HybridSurface, PaperReading};
-use g2tess::surface::{lattice_bary, SchemeParams, Surface};
+use g2tess::surface::{lattice_bary, LatticePart, SchemeParams, Surface};
 use g2tess::topology::Topology;
 use support::*;
 
@@ -43,6 +44,23 @@ fn assert_lattice_is_pointwise(name: &str, s: &dyn Surface, triangles: usize) {
             s.evaluate_lattice_points(t, level, &points, &mut some);
             for (p, &(i, j)) in some.iter().zip(&points) {
                 assert_eq!(*p, s.evaluate(t, lattice_bary(level, i, j)), "{name}");
+            }
+
+            // The parts the tessellator asks for: interior and each edge.
+            for part in [
+                LatticePart::Interior,
+                LatticePart::Edge(0),
+                LatticePart::Edge(1),
+                LatticePart::Edge(2),
+            ] {
+                let mut got = Vec::new();
+                s.evaluate_lattice_part(t, level, part, &mut got);
+                let want: Vec<_> = part
+                    .points(level)
+                    .iter()
+                    .map(|&(i, j)| s.evaluate(t, lattice_bary(level, i, j)))
+                    .collect();
+                assert_eq!(got, want, "{name}: triangle {t} level {level} {part:?}");
             }
         }
     }
