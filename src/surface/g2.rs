@@ -60,7 +60,7 @@ impl G2Surface {
         let (h_edge, warnings) = effective_widths(topo, h_per_edge);
         let corners: Vec<([DVec3; 3], [DVec3; 3])> = mesh
             .triangles
-            .iter()
+            .par_iter()
             .map(|tri| {
                 let position = tri.map(|c| mesh.positions[c as usize]);
                 let face = (position[1] - position[0])
@@ -72,7 +72,7 @@ impl G2Surface {
                 )
             })
             .collect();
-        let mut nets: Vec<Net> = corners.iter().map(|&(p, n)| pn_net(p, n)).collect();
+        let mut nets: Vec<Net> = corners.par_iter().map(|&(p, n)| pn_net(p, n)).collect();
         share_unblended_edge_curves(topo, &h_edge, &mut nets);
 
         let patches: Vec<Patch> = corners
