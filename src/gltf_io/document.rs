@@ -449,10 +449,23 @@ impl Document {
             extras: Default::default(),
         });
         self.buffers.push(Arc::new(data));
+        self.push_view_entry(self.buffers.len() - 1, 0, len, stride, target)
+    }
+
+    /// Appends a buffer view entry over `len` bytes of buffer `buffer` from `offset`; returns
+    /// its index.
+    fn push_view_entry(
+        &mut self,
+        buffer: usize,
+        offset: usize,
+        len: usize,
+        stride: Option<usize>,
+        target: Option<gltf_json::buffer::Target>,
+    ) -> usize {
         self.root.buffer_views.push(gltf_json::buffer::View {
-            buffer: gltf_json::Index::new((self.buffers.len() - 1) as u32),
+            buffer: gltf_json::Index::new(buffer as u32),
             byte_length: USize64(len as u64),
-            byte_offset: Some(USize64(0)),
+            byte_offset: Some(USize64(offset as u64)),
             byte_stride: stride.map(gltf_json::buffer::Stride),
             name: None,
             target: target.map(gltf_json::validation::Checked::Valid),
@@ -469,6 +482,13 @@ impl Document {
         stride: Option<usize>,
         target: Option<gltf_json::buffer::Target>,
     ) -> usize {
+        let (scratch, offset) = self.append_to_scratch(bytes);
+        self.push_view_entry(scratch, offset, bytes.len(), stride, target)
+    }
+
+    /// Appends `bytes` to the scratch buffer at the next 4-byte boundary; returns the scratch
+    /// buffer's index and where the bytes start.
+    fn append_to_scratch(&mut self, bytes: &[u8]) -> (usize, usize) {
         let scratch = self.scratch_buffer();
         let data = Arc::make_mut(&mut self.buffers[scratch]).bytes_mut();
         while data.len() % 4 != 0 {
@@ -477,17 +497,7 @@ impl Document {
         let offset = data.len();
         data.extend_from_slice(bytes);
         self.root.buffers[scratch].byte_length = USize64(data.len() as u64);
-        self.root.buffer_views.push(gltf_json::buffer::View {
-            buffer: gltf_json::Index::new(scratch as u32),
-            byte_length: USize64(bytes.len() as u64),
-            byte_offset: Some(USize64(offset as u64)),
-            byte_stride: stride.map(gltf_json::buffer::Stride),
-            name: None,
-            target: target.map(gltf_json::validation::Checked::Valid),
-            extensions: None,
-            extras: Default::default(),
-        });
-        self.root.buffer_views.len() - 1
+        (scratch, offset)
     }
 
     /// The in-memory buffer that new views go into, created on first use.
@@ -514,14 +524,7 @@ impl Document {
 
     /// Points buffer view `view` at `bytes` (decoded meshopt data) in the scratch buffer.
     pub(crate) fn relocate_view(&mut self, view: usize, bytes: &[u8]) {
-        let scratch = self.scratch_buffer();
-        let data = Arc::make_mut(&mut self.buffers[scratch]).bytes_mut();
-        while data.len() % 4 != 0 {
-            data.push(0);
-        }
-        let offset = data.len();
-        data.extend_from_slice(bytes);
-        self.root.buffers[scratch].byte_length = USize64(data.len() as u64);
+        let (scratch, offset) = self.append_to_scratch(bytes);
         let v = &mut self.root.buffer_views[view];
         v.buffer = gltf_json::Index::new(scratch as u32);
         v.byte_offset = Some(USize64(offset as u64));

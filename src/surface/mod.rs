@@ -104,13 +104,8 @@ pub trait Surface: Sync {
         part: LatticePart,
         out: &mut Vec<SurfacePoint>,
     ) {
-        let points = part.points(level);
-        out.reserve(points.len());
-        out.extend(
-            points
-                .iter()
-                .map(|&(i, j)| self.evaluate(tri, lattice_bary(level, i, j))),
-        );
+        // Through the surface's own scattered-point path, which may have cached weights.
+        self.evaluate_lattice_points(tri, level, &part.points(level), out);
     }
 
     /// Some points `(i, j)` of the level-`level` lattice of triangle `tri`, appended to `out` in

@@ -63,7 +63,7 @@ use super::hybrid::{EdgeNets, PaperReading};
 use super::pn::{compose, Net, IJK};
 use super::scheme::creases::{own_nets, smooth_edges, Corners};
 use super::scheme::{SchemeParams, Warning};
-use super::{blend, lattice_bary, lattice_index, lattice_len, LatticePart, Surface, SurfacePoint};
+use super::{blend, lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::topology::Topology;
 use patch::Definition2;
@@ -389,18 +389,6 @@ impl Surface for CoonsSurface {
                 });
             }
         }
-    }
-
-    /// Through the cached lattice weights, like [`Surface::evaluate_lattice_points`] (the
-    /// tessellator asks for interiors and edges by part).
-    fn evaluate_lattice_part(
-        &self,
-        tri: usize,
-        level: u32,
-        part: LatticePart,
-        out: &mut Vec<SurfacePoint>,
-    ) {
-        self.evaluate_lattice_points(tri, level, &part.points(level), out);
     }
 
     fn evaluate_lattice_points(

@@ -45,7 +45,7 @@ use glam::DVec3;
 use super::pn::{Net, B111, NEAR};
 use super::scheme::creases::{edge_end_normal, own_nets, smooth_edges, Corners};
 use super::scheme::Warning;
-use super::{lattice_bary, lattice_index, lattice_len, LatticePart, Surface, SurfacePoint};
+use super::{lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeId, Topology};
 use foley_opitz::{apex_barycentrics, interior_point, neighbour_interior, Labelled};
@@ -362,18 +362,6 @@ impl Surface for HybridSurface {
                 }
             }
         }
-    }
-
-    /// Through the cached lattice weights, like [`Surface::evaluate_lattice_points`] (the
-    /// tessellator asks for interiors and edges by part).
-    fn evaluate_lattice_part(
-        &self,
-        tri: usize,
-        level: u32,
-        part: LatticePart,
-        out: &mut Vec<SurfacePoint>,
-    ) {
-        self.evaluate_lattice_points(tri, level, &part.points(level), out);
     }
 
     fn evaluate_lattice_points(
