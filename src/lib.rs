@@ -26,6 +26,8 @@
 //! - [`optimize`]: meshoptimizer's vertex cache and fetch ordering.
 //! - [`options`]: the resolved settings that flow down through every stage.
 //! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages.
+//! - [`huge_pages`]: the binary's allocator, which asks Linux for transparent huge pages on
+//!   large buffers (fewer page faults when a dense mesh fills hundreds of MiB).
 //!
 //! **Architecture invariant:** [`mesh`], [`topology`], [`surface`], [`continuity`],
 //! [`tessellate`], [`attributes`] and [`normals`] take slices
@@ -38,6 +40,7 @@
 pub mod attributes;
 pub mod continuity;
 pub mod gltf_io;
+pub mod huge_pages;
 pub mod mesh;
 pub mod normals;
 pub mod optimize;
