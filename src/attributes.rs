@@ -82,12 +82,13 @@ pub fn carry(
                 let corners = tris.corners(source);
                 match rule {
                     Carry::Interpolate => {
+                        let bary = source.bary();
                         for (comp, o) in out.iter_mut().enumerate() {
                             // Accumulate in f64 so a value equal at all three corners comes out
                             // exact.
                             let v: f64 = (0..3)
                                 .map(|k| {
-                                    f64::from(source.bary[k])
+                                    f64::from(bary[k])
                                         * f64::from(attribute.values[corners[k] * c + comp])
                                 })
                                 .sum();
@@ -95,7 +96,7 @@ pub fn carry(
                         }
                     }
                     Carry::NearestCorner => {
-                        let k = corners[nearest_corner(source.bary)];
+                        let k = corners[nearest_corner(source.bary())];
                         out.copy_from_slice(&attribute.values[k * c..k * c + c]);
                     }
                 }
@@ -130,8 +131,9 @@ pub fn carry_skin(skin: &Skin, tris: SourceTriangles<'_>, sources: &[VertexSourc
     for source in sources {
         influences.clear();
         let corners = tris.corners(source);
+        let bary = source.bary();
         for (k, &corner) in corners.iter().enumerate() {
-            let b = f64::from(source.bary[k]);
+            let b = f64::from(bary[k]);
             if b == 0.0 {
                 continue;
             }
@@ -168,7 +170,7 @@ pub fn carry_skin(skin: &Skin, tris: SourceTriangles<'_>, sources: &[VertexSourc
         if total == 0.0 && sets > 0 {
             // No influence at all (an unskinned corner): bind fully to the first joint of the
             // nearest corner, as the glTF spec requires weights to sum to one.
-            let corner = corners[nearest_corner(source.bary)];
+            let corner = corners[nearest_corner(bary)];
             let last = out.joints[0].len() - 1;
             out.joints[0][last] = [skin.joints[0][corner][0], 0, 0, 0];
             out.weights[0][last] = [1.0, 0.0, 0.0, 0.0];
@@ -181,8 +183,9 @@ pub fn carry_skin(skin: &Skin, tris: SourceTriangles<'_>, sources: &[VertexSourc
 mod tests {
     use super::*;
 
-    fn src(tri: u32, bary: [f32; 3]) -> VertexSource {
-        VertexSource { tri, bary }
+    /// Lattice point `(i, j)` of level `n` of triangle `tri`.
+    fn src(tri: u32, n: u32, i: u32, j: u32) -> VertexSource {
+        VertexSource::lattice(tri, n, i, j)
     }
 
     #[test]
@@ -199,7 +202,7 @@ mod tests {
             &attr,
             Carry::Interpolate,
             tris,
-            &[src(5, [0.0, 1.0, 0.0]), src(5, [0.5, 0.25, 0.25])],
+            &[src(5, 1, 1, 0), src(5, 4, 1, 1)], // (0, 1, 0) and (0.5, 0.25, 0.25)
         );
         assert_eq!(out.values, vec![1.0, 0.0, 0.25, 0.25]);
     }
@@ -218,7 +221,7 @@ mod tests {
             &attr,
             Carry::NearestCorner,
             tris,
-            &[src(0, [0.2, 0.3, 0.5]), src(0, [0.4, 0.4, 0.2])],
+            &[src(0, 10, 3, 5), src(0, 5, 2, 1)], // (0.2, 0.3, 0.5) and (0.4, 0.4, 0.2)
         );
         assert_eq!(out.values, vec![11.0, 7.0]);
     }
@@ -237,7 +240,7 @@ mod tests {
             triangles: &[[0, 1, 2]],
             first_tri: 0,
         };
-        let out = carry_skin(&skin, tris, &[src(0, [1.0 / 3.0; 3])]);
+        let out = carry_skin(&skin, tris, &[src(0, 3, 1, 1)]); // the centroid
         let w = out.weights[0][0];
         assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-6);
         // Joint 1 gathers 0.5 + 0.4 from two corners and must come first; joint 4 (0.2/3) is

@@ -101,10 +101,7 @@ mod tests {
             for j in 0..2 {
                 mesh.positions.push([i as f32, j as f32, 0.0]);
                 mesh.normals.push([0.0, 0.0, 1.0]);
-                mesh.sources.push(VertexSource {
-                    tri: i,
-                    bary: [j as f32, 0.0, 0.0],
-                });
+                mesh.sources.push(VertexSource::lattice(i, 1, j, 0));
             }
         }
         let quad = |i: u32| [2 * i, 2 * i + 2, 2 * i + 1, 2 * i + 2, 2 * i + 3, 2 * i + 1];
@@ -136,6 +133,7 @@ mod tests {
         // Sources still travel with their positions.
         for (p, s) in mesh.positions.iter().zip(&mesh.sources) {
             assert_eq!(p[0], s.tri as f32);
+            assert_eq!(p[1], s.bary()[1]);
         }
     }
 }

@@ -151,7 +151,7 @@ fn vertices_lie_on_the_surface_with_its_normals() {
     let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
     let scale = mean_edge(&mesh);
     for (i, source) in dense.sources.iter().enumerate() {
-        let bary = source.bary.map(f64::from);
+        let bary = source.bary().map(f64::from);
         let p = surface.evaluate(source.tri as usize, bary);
         let got = DVec3::from(dense.positions[i].map(f64::from));
         // f32 storage and the f32 barycentrics of the source bound the difference.

@@ -1,6 +1,6 @@
-//! [`G2Surface`]: per-triangle control nets (own PN patch and the three neighbour patches
-//! re-expressed in its barycentrics) and their combination with [`PointWeights`] into positions
-//! and exact normals; [`PnSurface`] is its h = 0 case.
+//! [`G2Surface`]: per-triangle control nets (own PN patch, and the neighbour patches re-expressed
+//! in its barycentrics when they are needed) and their combination with [`PointWeights`] into
+//! positions and exact normals; [`PnSurface`] is its h = 0 case.
 //!
 //! It deliberately computes no weights itself (see `pattern.rs`, `blend.rs`) and never fails:
 //! bad edges act as h = 0 and are reported through [`G2Surface::warnings`].
@@ -24,14 +24,27 @@ type SoaNet = [[f64; 10]; 3];
 struct Patch {
     /// Own PN net `b_f` (Eq. 2, with shared edge curves on unblended split edges).
     net: SoaNet,
-    /// `across[k]`: the neighbour's net composed with the map of Eq. 3, `b_g ∘ M`, for the
-    /// edge opposite corner `k` (a copy of `net` where that edge is not blended).
-    across: [SoaNet; 3],
+    /// `across[k]`: for a blended edge opposite corner `k`, the neighbour and its slots, from
+    /// which [`G2Surface::across_net`] composes `b_g ∘ M` (Eq. 3) when a point needs it.
+    ///
+    /// The composed nets are not stored: three of them per triangle were two thirds of the
+    /// surface's memory (720 of 1128 bytes), more than the dense output of a level-8 triangle,
+    /// and composing costs less than the page faults of holding them. Each is composed once per
+    /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
+    /// still agree bit for bit.
+    across: [Option<Across>; 3],
     /// Effective width of the edge opposite each corner.
     h: [f64; 3],
     /// Input corner positions and normalized input normals.
     position: [DVec3; 3],
     normal: [DVec3; 3],
+}
+
+/// The triangle across a blended edge and the slots `[p, q, r]` of [`neighbour_map`].
+#[derive(Debug, Clone, Copy)]
+struct Across {
+    tri: u32,
+    slots: [u8; 3],
 }
 
 /// The G² blended surface of Lee–Hwang–Yoon over a whole mesh, one width `h` per welded edge.
@@ -80,18 +93,17 @@ impl G2Surface {
             .enumerate()
             .map(|(t, &(position, normal))| {
                 let h = topo.tri_edges[t].map(|e| h_edge[e.0 as usize]);
-                let net = soa(&nets[t]);
                 let across = std::array::from_fn(|k| {
-                    if h[k] > 0.0 {
+                    (h[k] > 0.0).then(|| {
                         let n = topo.neighbours[t][k].expect("blended edges are interior");
-                        let cols = neighbour_map(k, n.slots.map(usize::from));
-                        soa(&compose(&nets[n.tri.0 as usize], cols))
-                    } else {
-                        net
-                    }
+                        Across {
+                            tri: n.tri.0,
+                            slots: n.slots,
+                        }
+                    })
                 });
                 Patch {
-                    net,
+                    net: soa(&nets[t]),
                     across,
                     h,
                     position,
@@ -112,6 +124,17 @@ impl G2Surface {
     /// The width each edge is actually blended with (0 for edges that are not).
     pub fn effective_h(&self) -> &[f64] {
         &self.h_edge
+    }
+
+    /// The neighbour's net across edge `k` of `patch` in `patch`'s barycentrics, `b_g ∘ M`
+    /// (Eq. 3 in the form of [`neighbour_map`]); `k` must be a blended edge.
+    fn across_net(&self, patch: &Patch, k: usize) -> SoaNet {
+        let across = patch.across[k].expect("only blended edges are composed");
+        let g = aos(&self.patches[across.tri as usize].net);
+        soa(&compose(
+            &g,
+            neighbour_map(k, across.slots.map(usize::from)),
+        ))
     }
 
     /// The profile `r(s)` in use.
@@ -214,6 +237,11 @@ fn soa(net: &Net) -> SoaNet {
     [0, 1, 2].map(|c| net.map(|p| p[c]))
 }
 
+/// A net by control point (the inverse of [`soa`], bit for bit).
+fn aos(net: &SoaNet) -> Net {
+    std::array::from_fn(|m| DVec3::new(net[0][m], net[1][m], net[2][m]))
+}
+
 impl Surface for G2Surface {
     fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
         let patch = &self.patches[tri];
@@ -226,7 +254,9 @@ impl Surface for G2Surface {
             };
         }
         let own = broadcast(&patch.net);
-        let across = w.blended.then(|| broadcast(&patch.across[w.k as usize]));
+        let across = w
+            .blended
+            .then(|| broadcast(&self.across_net(patch, w.k as usize)));
         let [p] = Self::combine(patch, &Lanes::<1>::single(&w), &own, across.as_ref());
         p
     }
@@ -262,7 +292,7 @@ impl Surface for G2Surface {
             if blocks.is_empty() {
                 continue;
             }
-            let across = k.map(|k| broadcast(&patch.across[k]));
+            let across = k.map(|k| broadcast(&self.across_net(patch, k)));
             for lanes in blocks {
                 let points = Self::combine(patch, lanes, &own, across.as_ref());
                 for (&target, p) in lanes.target.iter().zip(points) {

@@ -117,7 +117,8 @@ const FACT: [f64; 4] = [1.0, 1.0, 2.0, 6.0];
 /// `b_g ∘ M` is again a cubic in λ; its control points are blossom values of `b_g` at the
 /// columns of `M`, `c_ijk = 𝔟_g(M e_0 ×i, M e_1 ×j, M e_2 ×k)`. The neighbour map of Eq. 3 (as
 /// corrected in the notes, item 3) has small-integer columns, so this is exact up to rounding,
-/// and it is done once per edge: afterwards both patches share one set of Bernstein values.
+/// and it is done per lattice part that blends across the edge (or per blended point): afterwards
+/// both patches share one set of Bernstein values.
 ///
 /// The ten blossom values share their first steps: one de Casteljau step per column gives three
 /// quadratic nets, four more steps the linear nets the ten values are read from (120 vector

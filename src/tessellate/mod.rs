@@ -41,22 +41,61 @@ mod layout;
 mod plan;
 
 use crate::mesh::TriMesh;
-use crate::surface::{LatticePart, Surface, SurfacePoint};
+use crate::surface::{lattice_bary, LatticePart, Surface, SurfacePoint};
 use crate::topology::{EdgeId, Topology};
 use layout::GroupLayout;
 use plan::LatticePlan;
 use rayon::prelude::*;
 use std::ops::Range;
 
-/// Where an output vertex was sampled: a source triangle (index into the whole mesh) and the
-/// barycentric coordinates inside it. Attributes are interpolated from these.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Where an output vertex was sampled: a source triangle (index into the whole mesh) and a point
+/// of that triangle's level-n lattice. Attributes are interpolated from these.
+///
+/// Kept to eight bytes because there is one per output vertex: with the barycentrics stored as
+/// three floats it was 16 bytes, a quarter of the dense mesh's memory, and on a 6.45 M-triangle
+/// output every MiB of fresh memory is time spent in page faults.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct VertexSource {
     /// Source triangle in the whole mesh.
     pub tri: u32,
-    /// Barycentric coordinates in that triangle's corner order.
-    pub bary: [f32; 3],
+    level: u8,
+    i: u8,
+    j: u8,
 }
+
+impl VertexSource {
+    /// Lattice point `(i, j)` of triangle `tri` at level `level`: barycentrics
+    /// `((n − i − j)/n, i/n, j/n)` in the triangle's corner order, as
+    /// [`lattice_bary`](crate::surface::lattice_bary) numbers them.
+    ///
+    /// # Panics
+    /// If `level` is 0 or above [`MAX_TESSELLATION_LEVEL`], or `i + j > level`.
+    pub fn lattice(tri: u32, level: u32, i: u32, j: u32) -> Self {
+        assert!(
+            (1..=MAX_TESSELLATION_LEVEL).contains(&level) && i + j <= level,
+            "lattice point ({i}, {j}) of level {level}"
+        );
+        VertexSource {
+            tri,
+            level: level as u8,
+            i: i as u8,
+            j: j as u8,
+        }
+    }
+
+    /// Barycentric coordinates in the source triangle's corner order. Exact at corners (one
+    /// coordinate is 1.0, the others 0.0) and along edges (one is 0.0).
+    #[inline]
+    pub fn bary(self) -> [f32; 3] {
+        let n = u32::from(self.level);
+        lattice_bary(n, u32::from(self.i), u32::from(self.j)).map(|x| x as f32)
+    }
+}
+
+/// The finest level the tessellator takes (a lattice coordinate is stored in a byte; the
+/// command line allows up to [`crate::options::MAX_LEVEL`]).
+pub const MAX_TESSELLATION_LEVEL: u32 = u8::MAX as u32;
+const _: () = assert!(crate::options::MAX_LEVEL <= MAX_TESSELLATION_LEVEL);
 
 /// The dense output of one group of source triangles.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -86,6 +125,9 @@ const BLOCK_TRIANGLES: usize = 16 * 1024;
 /// Tessellates `groups` (contiguous triangle ranges of `mesh`, one per output primitive) at
 /// level `level` (≥ 1). `h` is the blend width per welded edge, used only to decide which
 /// interior edges are creases (h = 0) and get split output vertices.
+///
+/// # Panics
+/// If `level` is above [`MAX_TESSELLATION_LEVEL`] (a caller bug: the options refuse it).
 pub fn tessellate(
     mesh: &TriMesh,
     topo: &Topology,
@@ -94,6 +136,10 @@ pub fn tessellate(
     level: u32,
     groups: &[Range<usize>],
 ) -> Vec<DenseMesh> {
+    assert!(
+        level <= MAX_TESSELLATION_LEVEL,
+        "level {level} is above {MAX_TESSELLATION_LEVEL}"
+    );
     let plan = LatticePlan::new(level.max(1));
     let edge_samples = shared_edge_samples(mesh, topo, surface, plan.n);
     groups
@@ -207,15 +253,15 @@ fn tessellate_group(
     let mut out = DenseMesh {
         positions: vec![[0.0; 3]; vertex_count],
         normals: vec![[0.0; 3]; vertex_count],
-        sources: vec![
-            VertexSource {
-                tri: 0,
-                bary: [0.0; 3]
-            };
-            vertex_count
-        ],
+        sources: Vec::with_capacity(vertex_count),
         indices: vec![0; range.len() * per_tri_indices],
     };
+    // Every slot is overwritten below; filling in parallel spreads the first touch of the
+    // pages (the other buffers are zeroed by the kernel as they are first written).
+    out.sources.par_extend(rayon::iter::repeat_n(
+        VertexSource::lattice(0, 1, 0, 0),
+        vertex_count,
+    ));
 
     // Cut the buffers into per-block slices.
     let tris_per_block = (BLOCK_TRIANGLES / (n * n) as usize).max(1);
@@ -295,9 +341,9 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
         let tri = first_tri + offset;
         let corners = mesh.triangles[tri];
         let owns = layout.owns[offset];
-        let source = |li: usize| VertexSource {
-            tri: tri as u32,
-            bary: plan.bary[li],
+        let source = |li: usize| {
+            let [i, j] = plan.lattice_ij[li];
+            VertexSource::lattice(tri as u32, n, u32::from(i), u32::from(j))
         };
 
         for (c, &li) in plan.corners.iter().enumerate() {

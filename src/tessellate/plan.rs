@@ -5,7 +5,7 @@
 //! It deliberately knows no mesh and no surface: only lattice indices.
 
 use super::lattice_edges::SampleKind;
-use crate::surface::{lattice_bary, lattice_index, lattice_len};
+use crate::surface::{lattice_index, lattice_len};
 
 /// Rows of sub-triangles per band of the emission order. A band is walked column by column, so
 /// the vertices in flight are two columns of `BAND + 1` points: 16, which is exactly the FIFO
@@ -21,8 +21,9 @@ pub(crate) struct LatticePlan {
     pub n: u32,
     /// Number of lattice points, `(n + 1)(n + 2)/2`.
     pub len: usize,
-    /// Barycentrics of each lattice point as stored in [`super::VertexSource`].
-    pub bary: Vec<[f32; 3]>,
+    /// Lattice coordinates `(i, j)` of each lattice point, as stored in
+    /// [`super::VertexSource`].
+    pub lattice_ij: Vec<[u8; 2]>,
     /// Lattice index of each corner.
     pub corners: [u32; 3],
     /// `edges[k][m − 1]`: lattice index of step `m` along the edge opposite corner `k`, walked
@@ -44,11 +45,11 @@ impl LatticePlan {
     pub fn new(n: u32) -> LatticePlan {
         let len = lattice_len(n);
         let mut kinds = Vec::with_capacity(len);
-        let mut bary = Vec::with_capacity(len);
+        let mut lattice_ij = Vec::with_capacity(len);
         for j in 0..=n {
             for i in 0..=n - j {
                 kinds.push(SampleKind::of(n, i, j));
-                bary.push(lattice_bary(n, i, j).map(|x| x as f32));
+                lattice_ij.push([i as u8, j as u8]);
             }
         }
         let triangles = banded_triangles(n);
@@ -74,7 +75,7 @@ impl LatticePlan {
         LatticePlan {
             n,
             len,
-            bary,
+            lattice_ij,
             corners,
             edges,
             interior: interior_by_rank.len(),
