@@ -8,9 +8,8 @@
 //! written). It deliberately reports one line per kind, with the first few triangles or vertices
 //! as examples, so that a scan of a million bad triangles gives a readable report.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeKind, Topology};
@@ -40,8 +39,10 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Strin
         "are kept flat; their edges are not blended",
     );
 
+    let sliver_cos = SLIVER_ANGLE.cos();
     let slivers: Vec<usize> = (0..mesh.triangles.len())
-        .filter(|&t| !topo.degenerate[t] && smallest_angle(mesh, t) < SLIVER_ANGLE)
+        .into_par_iter()
+        .filter(|&t| !topo.degenerate[t] && largest_angle_cosine(mesh, t) > sliver_cos)
         .collect();
     say(
         &mut out,
@@ -52,15 +53,7 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Strin
         "(an angle below 0.06°) are smoothed like the others; their shading may be poor",
     );
 
-    let mut seen: HashMap<[u32; 3], usize> = HashMap::new();
-    let mut duplicates = Vec::new();
-    for (t, v) in topo.tri_verts.iter().enumerate() {
-        let mut key = v.map(|x| x.0);
-        key.sort_unstable();
-        if key[0] != key[1] && key[1] != key[2] && seen.insert(key, t).is_some() {
-            duplicates.push(t);
-        }
-    }
+    let duplicates = duplicate_triangles(topo);
     say(
         &mut out,
         index,
@@ -86,20 +79,18 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Strin
         "are not written",
     );
 
-    let mut facing_away = Vec::new();
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        if topo.degenerate[t] {
-            continue;
-        }
-        let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
-        let face = (b - a).cross(c - a);
-        if tri
-            .iter()
-            .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
-        {
-            facing_away.push(t);
-        }
-    }
+    let facing_away: Vec<usize> = (0..mesh.triangles.len())
+        .into_par_iter()
+        .filter(|&t| {
+            let tri = mesh.triangles[t];
+            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+            let face = (b - a).cross(c - a);
+            !topo.degenerate[t]
+                && tri
+                    .iter()
+                    .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
+        })
+        .collect();
     say(
         &mut out,
         index,
@@ -181,11 +172,41 @@ fn first(v: &[usize]) -> &[usize] {
     &v[..v.len().min(EXAMPLES)]
 }
 
-fn smallest_angle(mesh: &TriMesh, t: usize) -> f64 {
+/// The cosine of the smallest angle of triangle `t`: comparing cosines instead of angles spares
+/// three arc cosines per triangle, and the order is the same (the cosine falls as the angle
+/// grows).
+fn largest_angle_cosine(mesh: &TriMesh, t: usize) -> f64 {
     let p: [DVec3; 3] = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
     (0..3)
-        .map(|k| (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]))
-        .fold(f64::INFINITY, f64::min)
+        .map(|k| {
+            let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+            (a.dot(b) / (a.length_squared() * b.length_squared()).sqrt()).clamp(-1.0, 1.0)
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// Triangles with the same three welded corners as an earlier triangle (in any order), in index
+/// order. Sorting the corner triples groups the copies: no hash map over every triangle.
+fn duplicate_triangles(topo: &Topology) -> Vec<usize> {
+    let mut keyed: Vec<([u32; 3], u32)> = topo
+        .tri_verts
+        .par_iter()
+        .enumerate()
+        .filter_map(|(t, v)| {
+            let mut key = v.map(|x| x.0);
+            key.sort_unstable();
+            (key[0] != key[1] && key[1] != key[2]).then_some((key, t as u32))
+        })
+        .collect();
+    // Entries are distinct (the triangle index differs), so the order is the one there is.
+    keyed.par_sort_unstable();
+    let mut out: Vec<usize> = keyed
+        .windows(2)
+        .filter(|w| w[0].0 == w[1].0)
+        .map(|w| w[1].1 as usize)
+        .collect();
+    out.sort_unstable();
+    out
 }
 
 /// Do both triangles of interior edge `e` run along it in the same direction (one of them is
@@ -202,51 +223,71 @@ fn same_direction(topo: &Topology, e: usize) -> bool {
 /// Welded vertices whose triangles form more than one fan (connected through edges that contain
 /// the vertex).
 fn bow_tie_vertices(topo: &Topology) -> Vec<usize> {
+    // The triangles around each welded vertex, in triangle order, as one array cut by offsets
+    // (one allocation instead of one per vertex).
     let n = topo.welded_positions.len();
-    let mut tris_of: Vec<Vec<u32>> = vec![Vec::new(); n];
+    let corners = |v: &[crate::topology::VertId; 3]| {
+        let [a, b, c] = v.map(|x| x.0 as usize);
+        [
+            Some(a),
+            (b != a).then_some(b),
+            (c != a && c != b).then_some(c),
+        ]
+    };
+    let mut start = vec![0usize; n + 1];
+    for v in &topo.tri_verts {
+        for x in corners(v).into_iter().flatten() {
+            start[x + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut around = vec![0u32; start[n]];
     for (t, v) in topo.tri_verts.iter().enumerate() {
-        for x in v {
-            if !tris_of[x.0 as usize].contains(&(t as u32)) {
-                tris_of[x.0 as usize].push(t as u32);
+        for x in corners(v).into_iter().flatten() {
+            around[fill[x]] = t as u32;
+            fill[x] += 1;
+        }
+    }
+    (0..n)
+        .into_par_iter()
+        .filter(|&v| {
+            let tris = &around[start[v]..start[v + 1]];
+            tris.len() >= 2 && fans_around(topo, v, tris) > 1
+        })
+        .collect()
+}
+
+/// The number of fans the triangles `tris` around welded vertex `v` form (connected through
+/// edges that contain `v`).
+fn fans_around(topo: &Topology, v: usize, tris: &[u32]) -> usize {
+    let mut parent: Vec<usize> = (0..tris.len()).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    for (i, &t) in tris.iter().enumerate() {
+        for &edge in &topo.tri_edges[t as usize] {
+            let e = &topo.edges[edge.0 as usize];
+            if e.verts[0].0 as usize != v && e.verts[1].0 as usize != v {
+                continue;
+            }
+            for &(u, _) in &e.tris {
+                if let Some(j) = tris.iter().position(|&x| x == u.0) {
+                    let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                    parent[a] = b;
+                }
             }
         }
     }
-    let mut out = Vec::new();
-    for (v, tris) in tris_of.iter().enumerate() {
-        if tris.len() < 2 {
-            continue;
-        }
-        // Union the triangles around v that share an edge through v.
-        let mut parent: Vec<usize> = (0..tris.len()).collect();
-        fn root(p: &mut [usize], mut i: usize) -> usize {
-            while p[i] != i {
-                p[i] = p[p[i]];
-                i = p[i];
-            }
-            i
-        }
-        for (i, &t) in tris.iter().enumerate() {
-            for &edge in &topo.tri_edges[t as usize] {
-                let e = &topo.edges[edge.0 as usize];
-                if e.verts[0].0 as usize != v && e.verts[1].0 as usize != v {
-                    continue;
-                }
-                for &(u, _) in &e.tris {
-                    if let Some(j) = tris.iter().position(|&x| x == u.0) {
-                        let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-                        parent[a] = b;
-                    }
-                }
-            }
-        }
-        let fans = (0..tris.len())
-            .filter(|&i| root(&mut parent, i) == i)
-            .count();
-        if fans > 1 {
-            out.push(v);
-        }
-    }
-    out
+    (0..tris.len())
+        .filter(|&i| root(&mut parent, i) == i)
+        .count()
 }
 
 /// Connected pieces of triangles (through welded edges).

@@ -92,7 +92,6 @@ pub(super) fn resolve(
     assign_offsets(&mut prepared);
     let (mesh, groups) = join(&prepared);
     let topo = Topology::build(&mesh);
-    warnings.extend(super::checks::mesh_warnings(input.mesh, &mesh, &topo));
     let contexts: Vec<PrimitiveContext> = input
         .primitives
         .iter()
@@ -110,7 +109,13 @@ pub(super) fn resolve(
         extras: input.extras.as_ref(),
         primitives: &contexts,
     };
-    let params = sharpness.resolve_mesh(&ctx, &mesh, &topo)?;
+    // The geometry checks only report: they run beside the resolution of h.
+    let (checks, params) = rayon::join(
+        || super::checks::mesh_warnings(input.mesh, &mesh, &topo),
+        || sharpness.resolve_mesh(&ctx, &mesh, &topo),
+    );
+    warnings.extend(checks);
+    let params = params?;
     warnings.extend(params.warnings.iter().map(|w| w.to_string()));
     Ok(Resolved {
         prepared,
