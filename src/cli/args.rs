@@ -117,8 +117,8 @@ pub struct Args {
     #[arg(long, help_heading = "Safety")]
     pub allow_outside_uris: bool,
 
-    /// Files processed at once; each one in flight holds its document in memory
-    /// [default: the number of CPUs]
+    /// Files processed at once, and threads for the work inside a file; each file in flight
+    /// holds its document in memory [default: RAYON_NUM_THREADS if set, else the number of CPUs]
     #[arg(short, long, value_name = "N", help_heading = "Batch")]
     pub jobs: Option<usize>,
 

@@ -269,39 +269,41 @@ impl Surface for G2Surface {
         out: &mut Vec<SurfacePoint>,
     ) {
         let patch = &self.patches[tri];
-        let pattern = self.patterns.get(level, part, patch.h, self.profile);
-        let base = out.len();
-        out.resize(
-            base + pattern.len,
-            SurfacePoint {
-                position: DVec3::ZERO,
-                normal: DVec3::ZERO,
-            },
-        );
-        let out = &mut out[base..];
-        for &(c, target) in &pattern.corners {
-            out[target as usize] = SurfacePoint {
-                position: patch.position[c as usize],
-                normal: patch.normal[c as usize],
-            };
-        }
-        let own = broadcast(&patch.net);
-        let groups = std::iter::once((None, &pattern.plain))
-            .chain((0..3).map(|k| (Some(k), &pattern.blended[k])));
-        for (k, blocks) in groups {
-            if blocks.is_empty() {
-                continue;
-            }
-            let across = k.map(|k| broadcast(&self.across_net(patch, k)));
-            for lanes in blocks {
-                let points = Self::combine(patch, lanes, &own, across.as_ref());
-                for (&target, p) in lanes.target.iter().zip(points) {
-                    if target != Lanes::<1>::PADDING {
-                        out[target as usize] = p;
+        self.patterns
+            .with(level, part, patch.h, self.profile, |pattern| {
+                let base = out.len();
+                out.resize(
+                    base + pattern.len,
+                    SurfacePoint {
+                        position: DVec3::ZERO,
+                        normal: DVec3::ZERO,
+                    },
+                );
+                let out = &mut out[base..];
+                for &(c, target) in &pattern.corners {
+                    out[target as usize] = SurfacePoint {
+                        position: patch.position[c as usize],
+                        normal: patch.normal[c as usize],
+                    };
+                }
+                let own = broadcast(&patch.net);
+                let groups = std::iter::once((None, &pattern.plain))
+                    .chain((0..3).map(|k| (Some(k), &pattern.blended[k])));
+                for (k, blocks) in groups {
+                    if blocks.is_empty() {
+                        continue;
+                    }
+                    let across = k.map(|k| broadcast(&self.across_net(patch, k)));
+                    for lanes in blocks {
+                        let points = Self::combine(patch, lanes, &own, across.as_ref());
+                        for (&target, p) in lanes.target.iter().zip(points) {
+                            if target != Lanes::<1>::PADDING {
+                                out[target as usize] = p;
+                            }
+                        }
                     }
                 }
-            }
-        }
+            });
     }
 }
 

@@ -26,6 +26,7 @@
 //! in SIMD registers while each point's sum keeps the order of the one-point evaluation: the
 //! lattice and [`Surface::evaluate`](super::Surface) agree bit for bit.
 
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::sync::{Arc, RwLock};
 
@@ -195,6 +196,15 @@ impl Pattern {
 /// Patterns keyed by level, lattice part, the bit patterns of the three widths, and the profile.
 type Key = (u32, LatticePart, [u64; 3], Profile);
 
+/// Patterns a thread keeps for [`PatternCache::with`]: a triangle's interior and its three edges,
+/// for two width triples.
+const RECENT_ENTRIES: usize = 8;
+
+thread_local! {
+    static RECENT: RefCell<Vec<(Key, Arc<Pattern>)>> =
+        const { RefCell::new(Vec::new()) };
+}
+
 /// A shared, thread-safe store of patterns. Meshes with many distinct width triples would make
 /// it grow without reuse, so past [`PatternCache::MAX_ENTRIES`] new patterns are built but not
 /// kept.
@@ -206,6 +216,42 @@ pub struct PatternCache {
 impl PatternCache {
     /// Most patterns kept (a whole level-16 lattice is about 80 kB).
     pub const MAX_ENTRIES: usize = 1024;
+
+    /// Runs `f` on the pattern for this key, built on first use.
+    ///
+    /// A tessellation asks once per triangle and part, from every thread at once, and mostly
+    /// for the same few keys. Each thread keeps the patterns it used last (a pattern depends on
+    /// its key alone, so a copy held by a thread is the pattern of any cache): a hit touches no
+    /// lock, no hash and no shared reference count. Through [`PatternCache::get`], the read
+    /// lock and the count, written by both threads on every call, cost more than the lookup.
+    /// `f` must not ask the cache again.
+    pub fn with<R>(
+        &self,
+        n: u32,
+        part: LatticePart,
+        h: [f64; 3],
+        profile: Profile,
+        f: impl FnOnce(&Pattern) -> R,
+    ) -> R {
+        let key = (n, part, h.map(f64::to_bits), profile);
+        let mut f = Some(f);
+        let hit = RECENT.with_borrow(|recent| {
+            let (_, pattern) = recent.iter().find(|(k, _)| *k == key)?;
+            f.take().map(|f| f(pattern))
+        });
+        if let Some(result) = hit {
+            return result;
+        }
+        let pattern = self.get(n, part, h, profile);
+        RECENT.with_borrow_mut(|recent| {
+            if recent.len() == RECENT_ENTRIES {
+                recent.remove(0);
+            }
+            recent.push((key, Arc::clone(&pattern)));
+        });
+        let f = f.take().expect("not called on a miss");
+        f(&pattern)
+    }
 
     /// The pattern for this key, built on first use.
     pub fn get(&self, n: u32, part: LatticePart, h: [f64; 3], profile: Profile) -> Arc<Pattern> {
