@@ -267,10 +267,20 @@ fn write_pieces_atomically<'a>(path: &Path, pieces: impl Iterator<Item = &'a [u8
     let tmp = builder
         .tempfile_in(parent_dir(path))
         .map_err(|e| Error::io(&shown, e))?;
-    // Small pieces (headers, padding) are gathered; large ones go to the file directly.
+    // Small pieces (headers, padding) are gathered; large ones go to the file directly, in
+    // steps, each handed to the disk as soon as it is written.
     let mut out = std::io::BufWriter::with_capacity(1 << 16, tmp);
+    let (mut written, mut handed) = (0u64, 0u64);
     for piece in pieces {
-        out.write_all(piece).map_err(|e| Error::io(&shown, e))?;
+        for step in piece.chunks(WRITEBACK_STEP) {
+            out.write_all(step).map_err(|e| Error::io(&shown, e))?;
+            written += step.len() as u64;
+            if written - handed >= WRITEBACK_STEP as u64 {
+                out.flush().map_err(|e| Error::io(&shown, e))?;
+                start_writeback(out.get_ref().as_file(), handed, written - handed);
+                handed = written;
+            }
+        }
     }
     let tmp = out
         .into_inner()
@@ -279,6 +289,29 @@ fn write_pieces_atomically<'a>(path: &Path, pieces: impl Iterator<Item = &'a [u8
     tmp.persist(path).map_err(|e| Error::io(&shown, e.error))?;
     Ok(())
 }
+
+/// Bytes written between two requests to start writing back to disk.
+const WRITEBACK_STEP: usize = 16 << 20;
+
+/// Asks the kernel to start writing `len` bytes at `offset` of `file` to disk now, without
+/// waiting. The final flush then waits only for what is left: on a 173 MiB output the disk
+/// works while the rest is still being copied, instead of after it. Advice only: an error
+/// (a file system without it) changes nothing but the timing.
+#[cfg(target_os = "linux")]
+fn start_writeback(file: &std::fs::File, offset: u64, len: u64) {
+    use std::os::fd::AsRawFd as _;
+    let (Ok(offset), Ok(len)) = (i64::try_from(offset), i64::try_from(len)) else {
+        return;
+    };
+    // SAFETY: the descriptor belongs to `file`, open for the duration of the call; the call
+    // reads no memory of ours.
+    unsafe {
+        libc::sync_file_range(file.as_raw_fd(), offset, len, libc::SYNC_FILE_RANGE_WRITE);
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn start_writeback(_file: &std::fs::File, _offset: u64, _len: u64) {}
 
 /// Builds the output JSON, its binary buffer, and (compressed, when asked) the uncompressed
 /// fallback buffer's bytes.
