@@ -66,7 +66,7 @@ pub struct VertexSource {
 impl VertexSource {
     /// Lattice point `(i, j)` of triangle `tri` at level `level`: barycentrics
     /// `((n − i − j)/n, i/n, j/n)` in the triangle's corner order, as
-    /// [`lattice_bary`](crate::surface::lattice_bary) numbers them.
+    /// [`lattice_bary`] numbers them.
     ///
     /// # Panics
     /// If `level` is 0 or above [`MAX_TESSELLATION_LEVEL`], or `i + j > level`.
