@@ -54,11 +54,10 @@ pub mod patch;
 pub mod weights;
 
 use std::collections::HashMap;
-use std::sync::Arc;
 
 use glam::DVec3;
 
-use super::hybrid::lattice::LatticeCache;
+use super::hybrid::lattice::{Entry, LatticeCache};
 use super::hybrid::{EdgeNets, PaperReading};
 use super::pn::{compose, Net, IJK};
 use super::scheme::creases::{own_nets, smooth_edges, Corners};
@@ -231,7 +230,7 @@ impl CoonsSurface {
 
     /// The lattice weights for triangle `tri`'s λ, when they are worth keeping and there is
     /// room; `None` means evaluate point by point (same values).
-    fn pattern(&self, tri: usize, level: u32) -> Option<Arc<Vec<LatticePoint>>> {
+    fn pattern(&self, tri: usize, level: u32) -> Option<Entry<'_, Vec<LatticePoint>>> {
         if self.normals != NormalMethod::Analytic || !self.shared_lambda[tri] {
             return None;
         }

@@ -49,7 +49,7 @@ use super::{lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeId, Topology};
 use foley_opitz::{apex_barycentrics, interior_point, neighbour_interior, Labelled};
-use lattice::LatticeCache;
+use lattice::{Entry, LatticeCache};
 use patch::{BoundaryBlend, Weights, TERMS};
 
 /// How to read seed 001's formulas. Only [`PaperReading::Corrected`] is a valid surface; the
@@ -306,7 +306,7 @@ impl HybridSurface {
     }
 
     /// The weights of every point of the level-`level` lattice, built on first use.
-    fn pattern(&self, level: u32) -> Option<std::sync::Arc<Vec<LatticePoint>>> {
+    fn pattern(&self, level: u32) -> Option<Entry<'_, Vec<LatticePoint>>> {
         self.patterns.get_or_build(level, || {
             let mut points = Vec::with_capacity(lattice_len(level));
             for j in 0..=level {
