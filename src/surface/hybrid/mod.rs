@@ -41,6 +41,7 @@ pub mod patch;
 pub mod plane;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::pn::{Net, B111, NEAR};
 use super::scheme::creases::{edge_end_normal, own_nets, smooth_edges, Corners};
@@ -247,8 +248,15 @@ fn boundary_net(position: [DVec3; 3], normal: [DVec3; 3], m: DVec3) -> Net {
 /// The parametric hybrid surface of seed 001 over a whole mesh.
 #[derive(Debug, Clone)]
 pub struct HybridSurface {
-    nets: EdgeNets,
-    /// Per triangle, the control points its [`Weights`] combine ([`patch::gather`]).
+    /// Per triangle, its corners (positions and normals).
+    corners: Vec<Corners>,
+    /// Per welded edge: G¹ (true) or a crease.
+    smooth: Vec<bool>,
+    /// Fallbacks taken while building.
+    warnings: Vec<Warning>,
+    /// Per triangle, the control points its [`Weights`] combine ([`patch::gather`]). The three
+    /// edge nets they are gathered from are not kept (720 bytes a triangle, read by nothing
+    /// after this).
     terms: Vec<[DVec3; TERMS]>,
     /// Per level, the weights of every lattice point, in lattice order.
     patterns: LatticeCache<u32, Vec<LatticePoint>>,
@@ -286,10 +294,17 @@ impl HybridSurface {
             PaperReading::PrintedStrayK => BoundaryBlend::PrintedStrayK,
             _ => BoundaryBlend::Corrected,
         };
-        let nets = EdgeNets::new(mesh, topo, h_per_edge, reading);
-        let terms = nets.nets.iter().map(|n| patch::gather(n, blend)).collect();
-        HybridSurface {
+        let EdgeNets {
+            corners,
             nets,
+            smooth,
+            warnings,
+        } = EdgeNets::new(mesh, topo, h_per_edge, reading);
+        let terms = nets.par_iter().map(|n| patch::gather(n, blend)).collect();
+        HybridSurface {
+            corners,
+            smooth,
+            warnings,
             terms,
             patterns: LatticeCache::new(Self::MAX_PATTERNS),
         }
@@ -297,12 +312,12 @@ impl HybridSurface {
 
     /// Per welded edge: smooth (G¹) or a crease.
     pub fn smooth_edges(&self) -> &[bool] {
-        &self.nets.smooth
+        &self.smooth
     }
 
     /// Fallbacks taken while building.
     pub fn warnings(&self) -> &[Warning] {
-        &self.nets.warnings
+        &self.warnings
     }
 
     /// The weights of every point of the level-`level` lattice, built on first use.
@@ -326,7 +341,7 @@ impl HybridSurface {
     /// the one path of both [`Surface::evaluate`] and the lattice.
     #[inline]
     fn combine(&self, tri: usize, l: [f64; 3], w: &Weights) -> SurfacePoint {
-        let corners = &self.nets.corners[tri];
+        let corners = &self.corners[tri];
         if let Some(p) = corners.at_corner(l) {
             return p;
         }
@@ -340,7 +355,7 @@ impl HybridSurface {
 
 impl Surface for HybridSurface {
     fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
-        if let Some(p) = self.nets.corners[tri].at_corner(bary) {
+        if let Some(p) = self.corners[tri].at_corner(bary) {
             return p;
         }
         self.combine(tri, bary, &patch::weights(bary))
