@@ -56,6 +56,7 @@ pub mod weights;
 use std::collections::HashMap;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::hybrid::lattice::{Entry, LatticeCache};
 use super::hybrid::{EdgeNets, PaperReading};
@@ -161,7 +162,9 @@ impl CoonsSurface {
             params.lambda.clamp(lo, hi)
         };
         let lambda = if params.fair {
-            nets.iter()
+            // Each triangle is faired alone (a fixed search on its own nets), so the result
+            // does not depend on how the work is split.
+            nets.par_iter()
                 .map(|r| fair::fair_lambda(r, start, Self::FAIR_RANGE))
                 .collect()
         } else {
