@@ -12,7 +12,7 @@
 //! The search is bounded to [`super::CoonsSurface::FAIR_RANGE`]: with wider bounds λ runs to the
 //! ends, where μ changes sharply near the corners, which the quadrature does not see.
 
-use super::patch::{point, Definition2};
+use super::patch::{point_at, sample, Definition2, Sample};
 use crate::surface::pn::Net;
 
 /// Central-difference step for the second derivatives (barycentric units).
@@ -25,22 +25,51 @@ const SWEEPS: usize = 2;
 /// The thin-plate energy of the patch with constituents `r` and parameters `lambda`, up to a
 /// constant factor (the quadrature's area weight).
 pub fn energy(r: &[Net; 3], lambda: [f64; 3]) -> f64 {
-    let f = |l: [f64; 3]| point(r, lambda, l, Definition2::Corrected);
-    let at = |l: [f64; 3], a: f64, b: f64| f([l[0] + a, l[1] + b, l[2] - a - b]);
-    let n = 7;
-    let mut sum = 0.0;
-    for j in 1..n {
-        for i in 1..n - j {
-            let l = [
-                (n - i - j) as f64 / n as f64,
-                i as f64 / n as f64,
-                j as f64 / n as f64,
-            ];
-            let h = STEP;
-            let c = at(l, 0.0, 0.0);
-            let (up, um) = (at(l, h, 0.0), at(l, -h, 0.0));
-            let (vp, vm) = (at(l, 0.0, h), at(l, 0.0, -h));
-            let (pp, pm, mp, mm) = (at(l, h, h), at(l, h, -h), at(l, -h, h), at(l, -h, -h));
+    Quadrature::new(r).energy(lambda)
+}
+
+/// The patch's λ-free parts at every point the energy's quadrature and differences read: per
+/// quadrature point, the centre and its eight neighbours at ±[`STEP`]. Built once per triangle,
+/// so that each of the search's hundred energies only blends.
+struct Quadrature {
+    stencils: Vec<[Sample<f64>; 9]>,
+}
+
+impl Quadrature {
+    fn new(r: &[Net; 3]) -> Self {
+        let at = |l: [f64; 3], a: f64, b: f64| sample(r, [l[0] + a, l[1] + b, l[2] - a - b]);
+        let n = 7;
+        let h = STEP;
+        let mut stencils = Vec::with_capacity(15);
+        for j in 1..n {
+            for i in 1..n - j {
+                let l = [
+                    (n - i - j) as f64 / n as f64,
+                    i as f64 / n as f64,
+                    j as f64 / n as f64,
+                ];
+                stencils.push([
+                    at(l, 0.0, 0.0),
+                    at(l, h, 0.0),
+                    at(l, -h, 0.0),
+                    at(l, 0.0, h),
+                    at(l, 0.0, -h),
+                    at(l, h, h),
+                    at(l, h, -h),
+                    at(l, -h, h),
+                    at(l, -h, -h),
+                ]);
+            }
+        }
+        Quadrature { stencils }
+    }
+
+    fn energy(&self, lambda: [f64; 3]) -> f64 {
+        let f = |s: &Sample<f64>| point_at(s, lambda, Definition2::Corrected);
+        let h = STEP;
+        let mut sum = 0.0;
+        for stencil in &self.stencils {
+            let [c, up, um, vp, vm, pp, pm, mp, mm] = stencil.each_ref().map(f);
             for d in 0..3 {
                 let fuu = (up[d] - 2.0 * c[d] + um[d]) / (h * h);
                 let fvv = (vp[d] - 2.0 * c[d] + vm[d]) / (h * h);
@@ -48,22 +77,23 @@ pub fn energy(r: &[Net; 3], lambda: [f64; 3]) -> f64 {
                 sum += fuu * fuu + 2.0 * fuv * fuv + fvv * fvv;
             }
         }
+        sum
     }
-    sum
 }
 
 /// The faired `(λ1, λ2, λ3)` within `[lo, hi]`, starting from `start`: coordinate descent with
 /// golden-section search.
 pub fn fair_lambda(r: &[Net; 3], start: f64, (lo, hi): (f64, f64)) -> [f64; 3] {
     let inv_phi = (5f64.sqrt() - 1.0) / 2.0;
+    let quadrature = Quadrature::new(r);
     let mut lam = [start.clamp(lo, hi); 3];
-    let mut best = energy(r, lam);
+    let mut best = quadrature.energy(lam);
     for _ in 0..SWEEPS {
         for k in 0..3 {
             let e = |x: f64| {
                 let mut l = lam;
                 l[k] = x;
-                energy(r, l)
+                quadrature.energy(l)
             };
             let (mut a, mut b) = (lo, hi);
             let mut c = b - inv_phi * (b - a);

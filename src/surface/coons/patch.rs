@@ -56,10 +56,45 @@ pub enum Definition2 {
 /// The patch at barycentrics `x` (not a corner) from constituent nets `r` (net k for the edge
 /// opposite corner k) and shape parameters `lambda`.
 pub fn point<T: Num>(r: &[Net; 3], lambda: [f64; 3], x: V3<T>, def: Definition2) -> V3<T> {
-    let rx = [cubic(&r[0], x), cubic(&r[1], x), cubic(&r[2], x)];
+    point_at(&sample(r, x), lambda, def)
+}
+
+/// Everything [`point`] needs at one `x` that does not depend on λ: the constituents at `x` and,
+/// for each auxiliary curve, its point and the two constituents there with their cross
+/// derivatives. The fairing evaluates one patch at the same points for a hundred values of λ;
+/// these cubics were most of that work.
+#[derive(Debug, Clone, Copy)]
+pub struct Sample<T: Num> {
+    x: V3<T>,
+    rx: [V3<T>; 3],
+    aux: [Auxiliary<T>; 3],
+}
+
+/// The point `y` of auxiliary curve `g_{k+1}` (with direction `D_{k+1}` as its derivative) and
+/// the constituents its blend `A_{a+1}`, `a = k + 2`, combines there.
+#[derive(Debug, Clone, Copy)]
+struct Auxiliary<T: Num> {
+    y: V3<Dual<T, 1>>,
+    first: V3<Dual<T, 1>>,
+    second: V3<Dual<T, 1>>,
+}
+
+/// The λ-free part of the patch at `x` (see [`Sample`]).
+pub fn sample<T: Num>(r: &[Net; 3], x: V3<T>) -> Sample<T> {
+    Sample {
+        x,
+        rx: [cubic(&r[0], x), cubic(&r[1], x), cubic(&r[2], x)],
+        aux: std::array::from_fn(|k| auxiliary_sample(k, r, x)),
+    }
+}
+
+/// The patch at a [`Sample`]'s point for shape parameters `lambda`: the same arithmetic, in the
+/// same order, as [`point`] there.
+pub fn point_at<T: Num>(at: &Sample<T>, lambda: [f64; 3], def: Definition2) -> V3<T> {
+    let (x, rx) = (at.x, &at.rx);
     let mut sum_a = [T::cst(0.0); 3];
     for k in 0..3 {
-        sum_a = add(sum_a, blend(k, &rx, lambda, x));
+        sum_a = add(sum_a, blend(k, rx, lambda, x));
     }
     let sq = x.map(|c| c * c);
     let sigma: [T; 3] = std::array::from_fn(|k| sq[(k + 1) % 3] * sq[(k + 2) % 3]);
@@ -67,7 +102,7 @@ pub fn point<T: Num>(r: &[Net; 3], lambda: [f64; 3], x: V3<T>, def: Definition2)
     let mut q = [T::cst(0.0); 3];
     let mut s = [T::cst(0.0); 3];
     for k in 0..3 {
-        let (g, e) = auxiliary(k, r, lambda, x, def);
+        let (g, e) = auxiliary(k, &at.aux[k], lambda, def);
         q = add(q, mul(sigma[k] / total, g));
         s = add(s, mul(x[k] * sigma[k] / total, e));
     }
@@ -126,15 +161,10 @@ fn blend<T: Num>(k: usize, rx: &[V3<T>; 3], lambda: [f64; 3], x: V3<T>) -> V3<T>
     add(second, mul(m, sub(first, second)))
 }
 
-/// Auxiliary curve `g_{k+1}` and its cross derivative `E_{k+1}` at the parallel projection of
-/// `x` onto edge k: `π` has `x_k = 0` and keeps `x_{k+1}`; `D` has +1 at k and −1 at k+2.
-fn auxiliary<T: Num>(
-    k: usize,
-    r: &[Net; 3],
-    lambda: [f64; 3],
-    x: V3<T>,
-    def: Definition2,
-) -> (V3<T>, V3<T>) {
+/// The λ-free part of auxiliary curve `g_{k+1}` at `x`: its point, the parallel projection of
+/// `x` onto edge k (`π` has `x_k = 0` and keeps `x_{k+1}`), carrying the direction `D` (+1 at k,
+/// −1 at k+2) as its derivative, and the constituents of its blend there.
+fn auxiliary_sample<T: Num>(k: usize, r: &[Net; 3], x: V3<T>) -> Auxiliary<T> {
     let key = x[(k + 1) % 3];
     let mut pi = [T::cst(0.0); 3];
     pi[(k + 1) % 3] = key;
@@ -145,9 +175,23 @@ fn auxiliary<T: Num>(
     let y: V3<Dual<T, 1>> = std::array::from_fn(|c| Dual::new(pi[c], [T::cst(dir[c])]));
     // g_{k+1} uses the blend A_{a+1} with a = k + 2.
     let a = (k + 2) % 3;
+    Auxiliary {
+        y,
+        first: cubic(&r[a], y),
+        second: cubic(&r[(a + 2) % 3], y),
+    }
+}
+
+/// Auxiliary curve `g_{k+1}` and its cross derivative `E_{k+1}` from its λ-free part.
+fn auxiliary<T: Num>(
+    k: usize,
+    at: &Auxiliary<T>,
+    lambda: [f64; 3],
+    def: Definition2,
+) -> (V3<T>, V3<T>) {
+    let a = (k + 2) % 3;
+    let (y, first, second) = (at.y, at.first, at.second);
     let m = mu(lambda[a], y[a], y[(a + 2) % 3]);
-    let first = cubic(&r[a], y);
-    let second = cubic(&r[(a + 2) % 3], y);
     let value = add(second, mul(m, sub(first, second)));
     let g = value.map(|c| c.v);
     let e = match def {
