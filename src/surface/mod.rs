@@ -25,13 +25,15 @@
 //! inside, run for two points at a time, and no allocation. `benches/surface.rs` measures it.
 //!
 //! Module map: [`pn`] (control nets, Bernstein basis), [`profile`] (r(s)), [`blend`] (subdomain,
-//! t, β, neighbour map), [`pattern`] (geometry-free per-point weights, cached per lattice), and
+//! t, β, neighbour map), [`pattern`] (geometry-free per-point weights, cached per lattice in a
+//! [`lattice_cache`], as the other schemes' lattice weights are), and
 //! `g2.rs` ([`G2Surface`], [`PnSurface`]: nets per triangle, combination, normals).
 
 pub mod blend;
 pub mod coons;
 mod g2;
 pub mod hybrid;
+pub mod lattice_cache;
 pub mod pattern;
 pub mod pn;
 pub mod profile;

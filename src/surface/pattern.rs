@@ -26,11 +26,10 @@
 //! in SIMD registers while each point's sum keeps the order of the one-point evaluation: the
 //! lattice and [`Surface::evaluate`](super::Surface) agree bit for bit.
 
-use std::cell::RefCell;
-use std::collections::HashMap;
-use std::sync::{Arc, RwLock};
+use std::sync::Arc;
 
 use super::blend::BlendWeight;
+use super::lattice_cache::{Entry, LatticeCache};
 use super::pn::Bernstein;
 use super::profile::Profile;
 use super::{lattice_bary, LatticePart};
@@ -196,21 +195,16 @@ impl Pattern {
 /// Patterns keyed by level, lattice part, the bit patterns of the three widths, and the profile.
 type Key = (u32, LatticePart, [u64; 3], Profile);
 
-/// Patterns a thread keeps for [`PatternCache::with`]: a triangle's interior and its three edges,
-/// for two width triples.
-const RECENT_ENTRIES: usize = 8;
+/// A shared, thread-safe store of patterns (a [`LatticeCache`]). Meshes with many distinct width
+/// triples would make it grow without reuse, so past [`PatternCache::MAX_ENTRIES`] new patterns
+/// are built but not kept.
+#[derive(Debug)]
+pub struct PatternCache(LatticeCache<Key, Pattern>);
 
-thread_local! {
-    static RECENT: RefCell<Vec<(Key, Arc<Pattern>)>> =
-        const { RefCell::new(Vec::new()) };
-}
-
-/// A shared, thread-safe store of patterns. Meshes with many distinct width triples would make
-/// it grow without reuse, so past [`PatternCache::MAX_ENTRIES`] new patterns are built but not
-/// kept.
-#[derive(Debug, Default)]
-pub struct PatternCache {
-    map: RwLock<HashMap<Key, Arc<Pattern>>>,
+impl Default for PatternCache {
+    fn default() -> Self {
+        PatternCache(LatticeCache::new(Self::MAX_ENTRIES))
+    }
 }
 
 impl PatternCache {
@@ -219,12 +213,9 @@ impl PatternCache {
 
     /// Runs `f` on the pattern for this key, built on first use.
     ///
-    /// A tessellation asks once per triangle and part, from every thread at once, and mostly
-    /// for the same few keys. Each thread keeps the patterns it used last (a pattern depends on
-    /// its key alone, so a copy held by a thread is the pattern of any cache): a hit touches no
-    /// lock, no hash and no shared reference count. Through [`PatternCache::get`], the read
-    /// lock and the count, written by both threads on every call, cost more than the lookup.
-    /// `f` must not ask the cache again.
+    /// The G² surface evaluates its lattice inside `f` rather than holding the entry: measured
+    /// with callgrind, that form compiled the lattice loop to about a fifth fewer instructions
+    /// (1k input, level 16: 119.6 M against 152.5 M for the whole run).
     pub fn with<R>(
         &self,
         n: u32,
@@ -233,37 +224,21 @@ impl PatternCache {
         profile: Profile,
         f: impl FnOnce(&Pattern) -> R,
     ) -> R {
-        let key = (n, part, h.map(f64::to_bits), profile);
-        let mut f = Some(f);
-        let hit = RECENT.with_borrow(|recent| {
-            let (_, pattern) = recent.iter().find(|(k, _)| *k == key)?;
-            f.take().map(|f| f(pattern))
-        });
-        if let Some(result) = hit {
-            return result;
-        }
-        let pattern = self.get(n, part, h, profile);
-        RECENT.with_borrow_mut(|recent| {
-            if recent.len() == RECENT_ENTRIES {
-                recent.remove(0);
-            }
-            recent.push((key, Arc::clone(&pattern)));
-        });
-        let f = f.take().expect("not called on a miss");
-        f(&pattern)
+        f(&self.get(n, part, h, profile))
     }
 
     /// The pattern for this key, built on first use.
-    pub fn get(&self, n: u32, part: LatticePart, h: [f64; 3], profile: Profile) -> Arc<Pattern> {
+    pub fn get(
+        &self,
+        n: u32,
+        part: LatticePart,
+        h: [f64; 3],
+        profile: Profile,
+    ) -> Entry<'_, Pattern> {
         let key = (n, part, h.map(f64::to_bits), profile);
-        if let Some(p) = self.map.read().expect("pattern cache lock").get(&key) {
-            return Arc::clone(p);
-        }
-        let pattern = Arc::new(Pattern::new(n, part, h, profile));
-        let mut map = self.map.write().expect("pattern cache lock");
-        if map.len() < Self::MAX_ENTRIES {
-            map.entry(key).or_insert_with(|| Arc::clone(&pattern));
-        }
-        pattern
+        let build = || Pattern::new(n, part, h, profile);
+        self.0
+            .get_or_build(key, build)
+            .unwrap_or_else(|| Entry::Shared(Arc::new(build())))
     }
 }

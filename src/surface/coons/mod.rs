@@ -58,8 +58,8 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::hybrid::lattice::{Entry, LatticeCache};
 use super::hybrid::{EdgeNets, PaperReading};
+use super::lattice_cache::{Entry, LatticeCache};
 use super::pn::{compose, Net, IJK};
 use super::scheme::creases::{own_nets, smooth_edges, Corners};
 use super::scheme::{SchemeParams, Warning};

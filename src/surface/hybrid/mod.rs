@@ -36,13 +36,13 @@
 //! distance to the exact sphere sampled by an icosahedron 0.0131 (PN 0.0584).
 
 pub mod foley_opitz;
-pub mod lattice;
 pub mod patch;
 pub mod plane;
 
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::lattice_cache::{Entry, LatticeCache};
 use super::pn::{Net, B111, NEAR};
 use super::scheme::creases::{edge_end_normal, own_nets, smooth_edges, Corners};
 use super::scheme::Warning;
@@ -50,7 +50,6 @@ use super::{lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeId, Topology};
 use foley_opitz::{apex_barycentrics, interior_point, neighbour_interior, Labelled};
-use lattice::{Entry, LatticeCache};
 use patch::{BoundaryBlend, Weights, TERMS};
 
 /// How to read seed 001's formulas. Only [`PaperReading::Corrected`] is a valid surface; the
