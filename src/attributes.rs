@@ -45,17 +45,6 @@ impl SourceTriangles<'_> {
     }
 }
 
-/// The corner with the largest barycentric coordinate (ties to the lowest corner).
-pub fn nearest_corner(bary: [f32; 3]) -> usize {
-    let mut best = 0;
-    for c in 1..3 {
-        if bary[c] > bary[best] {
-            best = c;
-        }
-    }
-    best
-}
-
 /// Carries one attribute to the output vertices.
 pub fn carry(
     attribute: &FloatAttribute,
@@ -96,7 +85,7 @@ pub fn carry(
                         }
                     }
                     Carry::NearestCorner => {
-                        let k = corners[nearest_corner(source.bary())];
+                        let k = corners[source.nearest_corner()];
                         out.copy_from_slice(&attribute.values[k * c..k * c + c]);
                     }
                 }
@@ -170,7 +159,7 @@ pub fn carry_skin(skin: &Skin, tris: SourceTriangles<'_>, sources: &[VertexSourc
         if total == 0.0 && sets > 0 {
             // No influence at all (an unskinned corner): bind fully to the first joint of the
             // nearest corner, as the glTF spec requires weights to sum to one.
-            let corner = corners[nearest_corner(bary)];
+            let corner = corners[source.nearest_corner()];
             let last = out.joints[0].len() - 1;
             out.joints[0][last] = [skin.joints[0][corner][0], 0, 0, 0];
             out.weights[0][last] = [1.0, 0.0, 0.0, 0.0];

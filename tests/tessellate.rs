@@ -10,7 +10,7 @@ use std::collections::HashMap;
 
 use g2tess::mesh::TriMesh;
 use g2tess::surface::{G2Surface, Profile, Surface};
-use g2tess::tessellate::{tessellate, DenseMesh};
+use g2tess::tessellate::{tessellate, DenseMesh, VertexSource};
 use g2tess::topology::Topology;
 use glam::DVec3;
 use support::*;
@@ -210,5 +210,31 @@ fn shared_samples_are_evaluated_once_even_if_the_sides_disagree() {
             .pop()
             .unwrap();
         assert_eq!(boundary_edges(&dense.positions, &dense.indices), 0);
+    }
+}
+
+#[test]
+fn corner_tests_on_lattice_coordinates_agree_with_the_barycentrics() {
+    // The integer forms replace comparisons on the float barycentrics: they must pick the same
+    // corner (largest coordinate, ties to the lowest) at every point of every level.
+    for n in 1..=g2tess::options::MAX_LEVEL {
+        for j in 0..=n {
+            for i in 0..=n - j {
+                let s = VertexSource::lattice(7, n, i, j);
+                let b = s.bary();
+                let mut largest = 0;
+                for c in 1..3 {
+                    if b[c] > b[largest] {
+                        largest = c;
+                    }
+                }
+                assert_eq!(s.nearest_corner(), largest, "level {n}, ({i}, {j})");
+                assert_eq!(
+                    s.corner(),
+                    b.iter().position(|&x| x == 1.0),
+                    "level {n}, ({i}, {j})"
+                );
+            }
+        }
     }
 }

@@ -318,7 +318,7 @@ fn carry_one(a: &Attribute, tris: SourceTriangles<'_>, dense: &DenseMesh) -> Att
                 .iter()
                 .flat_map(|s| {
                     let t = tris.triangles[(s.tri - tris.first_tri) as usize];
-                    let k = t[attributes::nearest_corner(s.bary())] as usize;
+                    let k = t[s.nearest_corner()] as usize;
                     v[k * c..k * c + c].iter().copied()
                 })
                 .collect();
@@ -354,7 +354,7 @@ fn keep_exact_corner_normals(prep: &Prepared, dense: &mut DenseMesh, tris: Sourc
         .par_iter_mut()
         .zip(&dense.sources)
         .for_each(|(n, s)| {
-            let Some(c) = s.bary().iter().position(|&b| b == 1.0) else {
+            let Some(c) = s.corner() else {
                 return;
             };
             let v = tris.triangles[(s.tri - tris.first_tri) as usize][c] as usize;

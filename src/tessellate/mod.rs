@@ -90,6 +90,26 @@ impl VertexSource {
         let n = u32::from(self.level);
         lattice_bary(n, u32::from(self.i), u32::from(self.j)).map(|x| x as f32)
     }
+
+    /// The lattice coordinates `(n − i − j, i, j)`, one per corner.
+    #[inline]
+    fn steps(self) -> [u8; 3] {
+        [self.level - self.i - self.j, self.i, self.j]
+    }
+
+    /// The corner this vertex sits on, if it is one.
+    #[inline]
+    pub fn corner(self) -> Option<usize> {
+        self.steps().iter().position(|&s| s == self.level)
+    }
+
+    /// The corner with the largest barycentric coordinate, ties to the lowest corner: read from
+    /// the integer lattice coordinates, which order exactly as the barycentrics do.
+    #[inline]
+    pub fn nearest_corner(self) -> usize {
+        let steps = self.steps();
+        (1..3).fold(0, |best, c| if steps[c] > steps[best] { c } else { best })
+    }
 }
 
 /// The finest level the tessellator takes (a lattice coordinate is stored in a byte; the
@@ -341,9 +361,15 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
         let tri = first_tri + offset;
         let corners = mesh.triangles[tri];
         let owns = layout.owns[offset];
+        // The level was checked once in `tessellate`, the coordinates come from its plan.
         let source = |li: usize| {
             let [i, j] = plan.lattice_ij[li];
-            VertexSource::lattice(tri as u32, n, u32::from(i), u32::from(j))
+            VertexSource {
+                tri: tri as u32,
+                level: n as u8,
+                i,
+                j,
+            }
         };
 
         for (c, &li) in plan.corners.iter().enumerate() {
