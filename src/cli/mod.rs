@@ -71,19 +71,13 @@ pub fn run() -> i32 {
     if args.jobs == Some(0) {
         return usage_error("command line: jobs: is 0 (expected at least 1)");
     }
-    // RAYON_NUM_THREADS as rayon itself reads it (the pool below is sized explicitly, which
-    // would otherwise override it).
-    let from_env = std::env::var("RAYON_NUM_THREADS")
-        .ok()
-        .and_then(|v| v.trim().parse::<usize>().ok())
-        .filter(|&n| n > 0);
-    let threads = args.jobs.or(from_env).unwrap_or_else(|| {
-        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-    });
-    // The pipeline spreads each file's meshes over rayon's pool; size it like the file workers.
+    // The pipeline spreads each file's work over rayon's pool, and the file workers are as many
+    // as its threads. Without -j, rayon sizes the pool itself (RAYON_NUM_THREADS, else the
+    // number of CPUs).
     let _ = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
+        .num_threads(args.jobs.unwrap_or(0))
         .build_global();
+    let threads = rayon::current_num_threads();
     interrupt::install();
 
     let verbosity = match (args.quiet, args.verbose) {
