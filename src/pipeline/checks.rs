@@ -264,13 +264,6 @@ fn bow_tie_vertices(topo: &Topology) -> Vec<usize> {
 /// edges that contain `v`).
 fn fans_around(topo: &Topology, v: usize, tris: &[u32]) -> usize {
     let mut parent: Vec<usize> = (0..tris.len()).collect();
-    fn root(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
-    }
     for (i, &t) in tris.iter().enumerate() {
         for &edge in &topo.tri_edges[t as usize] {
             let e = &topo.edges[edge.0 as usize];
@@ -294,13 +287,6 @@ fn fans_around(topo: &Topology, v: usize, tris: &[u32]) -> usize {
 fn pieces(topo: &Topology) -> usize {
     let n = topo.tri_verts.len();
     let mut parent: Vec<usize> = (0..n).collect();
-    fn root(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
-    }
     for e in &topo.edges {
         for w in e.tris.windows(2) {
             let (a, b) = (
@@ -311,4 +297,13 @@ fn pieces(topo: &Topology) -> usize {
         }
     }
     (0..n).filter(|&i| root(&mut parent, i) == i).count()
+}
+
+/// The root of `i` in the union-find forest `p`, halving the path on the way.
+fn root(p: &mut [usize], mut i: usize) -> usize {
+    while p[i] != i {
+        p[i] = p[p[i]];
+        i = p[i];
+    }
+    i
 }
