@@ -168,9 +168,42 @@ pub struct Args {
     /// With --watch: wait until files have been quiet this many milliseconds [default: 200]
     #[arg(long, value_name = "MS", help_heading = "Watch", requires = "watch")]
     pub debounce: Option<u64>,
+
+    /// Print every file a run would read (assets, their buffers and images, sidecars, folder
+    /// configs, --config) and exit without processing: one per line, or with `json` one record
+    /// per input with what it reads, could read once created, and writes
+    #[arg(long, value_name = "FORMAT", value_enum, num_args = 0..=1, require_equals = true,
+        default_missing_value = "lines", help_heading = "Build systems",
+        conflicts_with_all = ["watch", "check", "merge_reports"])]
+    pub print_inputs: Option<InputsFormat>,
+
+    /// Write a Makefile-style depfile OUTPUT.d beside each output, listing the files it was made
+    /// from (the format of gcc -MD, read by Make and Ninja's `depfile`)
+    #[arg(long, help_heading = "Build systems", conflicts_with = "check")]
+    pub depfile: bool,
+
+    /// Process only shard K of N (1-based): an input belongs to the shard given by a hash of its
+    /// path, so every input is in exactly one shard whatever else the tree holds
+    #[arg(long, value_name = "K/N", value_parser = super::shard::Shard::parse,
+        help_heading = "Build systems", conflicts_with = "watch")]
+    pub shard: Option<super::shard::Shard>,
+
+    /// Merge the JSON reports given as INPUTs (e.g. one per shard) into FILE and exit with the
+    /// merged exit status
+    #[arg(long, value_name = "FILE", help_heading = "Build systems")]
+    pub merge_reports: Option<PathBuf>,
 }
 
 const EXIT_HELP: &str = "Exit status: 0 every input done (or up to date), 1 some input failed or, with --check, some output is not current (the others were still processed), 2 usage or configuration error, 130 stopped by Ctrl-C before the end (the files in flight were finished; --watch ends with 0).";
+
+/// `--print-inputs` formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum InputsFormat {
+    /// Every file once, one per line, in the order first read
+    Lines,
+    /// One JSON document with a record per input
+    Json,
+}
 
 /// `--profile` values.
 #[derive(Debug, Clone, Copy, ValueEnum)]

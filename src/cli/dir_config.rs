@@ -44,8 +44,7 @@ impl<'a> DirConfigs<'a> {
     }
 
     fn nearest(&mut self, job: &Job) -> Result<Option<(PathBuf, ConfigFile)>, String> {
-        let mut dir = parent_dir(&job.input).to_path_buf();
-        loop {
+        for dir in searched_dirs(job) {
             let found = self
                 .parsed
                 .entry(dir.clone())
@@ -53,12 +52,22 @@ impl<'a> DirConfigs<'a> {
             if let Some(result) = found {
                 return result.clone().map(|c| Some((dir.join(DIR_CONFIG), c)));
             }
-            if dir == job.config_root || !dir.starts_with(&job.config_root) {
-                return Ok(None);
-            }
-            dir = parent_dir(&dir).to_path_buf();
         }
+        Ok(None)
     }
+}
+
+/// The folders searched for `job`'s folder config, nearest first: its asset's folder and each
+/// one above it up to its config root.
+pub fn searched_dirs(job: &Job) -> Vec<PathBuf> {
+    let mut dirs = vec![parent_dir(&job.input).to_path_buf()];
+    while let Some(dir) = dirs.last() {
+        if *dir == job.config_root || !dir.starts_with(&job.config_root) {
+            break;
+        }
+        dirs.push(parent_dir(dir).to_path_buf());
+    }
+    dirs
 }
 
 fn read(file: &Path) -> Option<Result<ConfigFile, String>> {

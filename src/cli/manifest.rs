@@ -82,7 +82,7 @@ fn hash(bytes: &[u8]) -> u64 {
 }
 
 /// The buffer and image files a `.gltf` or `.glb` refers to, in document order.
-fn companions(asset: &Path, bytes: &[u8], allow_outside: bool) -> Vec<PathBuf> {
+pub(super) fn companions(asset: &Path, bytes: &[u8], allow_outside: bool) -> Vec<PathBuf> {
     let json = match glb::is_glb(bytes) {
         true => glb::split(bytes).map(|c| c.json).unwrap_or_default(),
         false => bytes,

@@ -1,18 +1,24 @@
 //! The binary's edge: parses [`args::Args`] once, resolves the settings, plans the jobs
 //! ([`scope`]), runs them ([`batch`]) once or on every change ([`watch`]), prints ([`progress`]),
-//! writes the JSON report ([`report`]) and chooses the exit status.
+//! writes the JSON report ([`report`]) and chooses the exit status. For build systems it lists
+//! what each asset reads ([`declared_inputs`]), writes depfiles ([`depfile`]), keeps one shard
+//! of a batch ([`shard`]) and merges shard reports ([`merge_reports`]).
 //!
 //! It deliberately keeps going after a failed input (the failure shows in the exit status), like
 //! any batch tool. Walking folders and watching them happen here, never in the library.
 
 mod args;
 mod batch;
+mod declared_inputs;
+mod depfile;
 mod dir_config;
 mod interrupt;
 mod manifest;
+mod merge_reports;
 mod progress;
 mod report;
 mod scope;
+mod shard;
 mod watch;
 
 use std::path::PathBuf;
@@ -48,6 +54,9 @@ pub fn run() -> i32 {
             return code;
         }
     };
+    if let Some(out) = &args.merge_reports {
+        return merge_reports::run(&args.inputs, out).unwrap_or_else(|e| usage_error(&e));
+    }
     let layers = match args.layers() {
         Ok(l) => l,
         Err(e) => return usage_error(&e.to_string()),
@@ -68,6 +77,22 @@ pub fn run() -> i32 {
         Ok(j) => j,
         Err(e) => return usage_error(&e),
     };
+    let jobs = match args.shard {
+        Some(shard) => shard.select(jobs),
+        None => jobs,
+    };
+    if let Some(format) = args.print_inputs {
+        let mut configs = DirConfigs::new(&layers);
+        let options: Vec<_> = jobs.iter().map(|j| configs.options(j)).collect();
+        let known = declared_inputs::print(
+            &jobs,
+            &options,
+            args.config.as_deref(),
+            args.depfile,
+            format,
+        );
+        return if known { EXIT_OK } else { EXIT_SOME_FAILED };
+    }
     if args.jobs == Some(0) {
         return usage_error("command line: jobs: is 0 (expected at least 1)");
     }
@@ -99,6 +124,7 @@ pub fn run() -> i32 {
         verbosity,
         timings: args.timings,
         report: args.report.clone(),
+        depfile: args.depfile.then(|| args.config.clone()),
         summary_always: args.inputs.len() > 1 || args.inputs.iter().any(|i| i.is_dir()),
         status: std::cell::Cell::new(EXIT_OK),
     };
@@ -127,6 +153,8 @@ pub struct Runner<'a> {
     verbosity: Verbosity,
     timings: bool,
     report: Option<PathBuf>,
+    /// `--depfile`: write one per current output; holds `--config`, which every run reads.
+    depfile: Option<Option<PathBuf>>,
     /// Print the summary line even for a single file.
     summary_always: bool,
     /// The exit status of the last round.
@@ -141,7 +169,7 @@ impl Runner<'_> {
         let mut configs = DirConfigs::new(self.layers);
         let options: Vec<_> = jobs.iter().map(|j| configs.options(j)).collect();
         let progress = Progress::new(jobs.len(), self.verbosity, self.timings);
-        let outcomes = batch::run(
+        let mut outcomes = batch::run(
             jobs,
             &options,
             manifests,
@@ -149,6 +177,9 @@ impl Runner<'_> {
             interrupt::flag(),
             &progress,
         );
+        if let Some(config) = &self.depfile {
+            depfile::write_all(jobs, &options, &mut outcomes, config.as_deref());
+        }
         let summary = Summary::of(&outcomes, started);
         let show = self.summary_always && (first || jobs.len() > 1)
             || self.verbosity == Verbosity::Verbose;

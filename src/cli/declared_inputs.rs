@@ -1,0 +1,170 @@
+//! Declared inputs: every file a run reads for an asset, so that a build system (Make, Ninja,
+//! Bazel, Buck2) can know an action's inputs. `--print-inputs` prints them without processing;
+//! the depfiles of [`super::depfile`] are written from the same list.
+//!
+//! Which files an asset reads is decided in one place, [`discover`], from the discovery the run
+//! itself uses (the companions named in the asset's JSON, the sidecar naming rule, the folder
+//! config search); this module only sorts the answer into what exists and what would be read
+//! once created. Paths are kept in the form the run uses them (as given on the command line, or
+//! joined below a folder input), so relative inputs give relative, relocatable lists.
+
+use std::path::{Path, PathBuf};
+
+use g2tess::gltf_io::write::fallback_path;
+use g2tess::options::Options;
+use g2tess::sharpness::sidecar_path_for;
+use serde::Serialize;
+
+use super::args::InputsFormat;
+use super::dir_config::{searched_dirs, DIR_CONFIG};
+use super::manifest::{companions, written_files};
+use super::scope::Job;
+
+/// What one asset's run reads.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Reads {
+    /// Files read: the asset, every buffer and image file it names (present or not: a missing
+    /// one fails the run), its sidecar, its folder config and `--config` when they exist.
+    pub reads: Vec<PathBuf>,
+    /// Files that are absent but would be read, changing the output, once created: the
+    /// sidecar beside the asset, and a `g2tess.toml` in a folder nearer than the one in use.
+    pub reads_if_created: Vec<PathBuf>,
+}
+
+/// Where the run's own discovery is asked what `job` reads: the one adapter between this module
+/// and the knowledge of companions, sidecars and folder configs. `None` when the asset cannot
+/// be read (the run would fail on it).
+fn discover(job: &Job, options: &Options) -> Option<Discovered> {
+    let bytes = std::fs::read(&job.input).ok()?;
+    Some(Discovered {
+        companions: companions(&job.input, &bytes, options.allow_outside_uris),
+        sidecar: options
+            .sidecar
+            .clone()
+            .map_or_else(|| (sidecar_path_for(&job.input), false), |s| (s, true)),
+        folder_configs: searched_dirs(job)
+            .into_iter()
+            .map(|d| d.join(DIR_CONFIG))
+            .collect(),
+    })
+}
+
+/// The raw answer of [`discover`].
+struct Discovered {
+    /// Buffer and image files named by the asset, in document order.
+    companions: Vec<PathBuf>,
+    /// The sidecar's path, and whether it was named (`--sidecar`: required) or only looked for.
+    sidecar: (PathBuf, bool),
+    /// The folder configs searched, nearest first; the first that exists is the one used.
+    folder_configs: Vec<PathBuf>,
+}
+
+impl Reads {
+    /// What `job` reads under `options`, with `config` (`--config`) read by every run. The error
+    /// names the asset when it cannot be read.
+    pub fn of(job: &Job, options: &Options, config: Option<&Path>) -> Result<Reads, String> {
+        let found = discover(job, options).ok_or_else(|| {
+            format!(
+                "{}: cannot be read, so the files it names are unknown",
+                job.input.display()
+            )
+        })?;
+        let mut reads = Reads::default();
+        reads.reads.push(job.input.clone());
+        reads.reads.extend(found.companions);
+        let (sidecar, named) = found.sidecar;
+        match named || sidecar.is_file() {
+            true => reads.reads.push(sidecar),
+            false => reads.reads_if_created.push(sidecar),
+        }
+        for folder_config in found.folder_configs {
+            if folder_config.is_file() {
+                reads.reads.push(folder_config);
+                break;
+            }
+            reads.reads_if_created.push(folder_config);
+        }
+        reads.reads.extend(config.map(Path::to_path_buf));
+        dedupe(&mut reads.reads);
+        Ok(reads)
+    }
+}
+
+/// Keeps the first of each path.
+fn dedupe(paths: &mut Vec<PathBuf>) {
+    let mut seen = std::collections::HashSet::new();
+    paths.retain(|p| seen.insert(p.clone()));
+}
+
+/// One record of `--print-inputs json`.
+#[derive(Serialize)]
+struct Record<'a> {
+    input: &'a Path,
+    output: &'a Path,
+    #[serde(flatten)]
+    reads: &'a Reads,
+    /// The files the run writes (a `.gltf`'s `.bin`, the depfile with `--depfile`).
+    writes: Vec<PathBuf>,
+    /// Why its inputs are unknown, when they are.
+    error: Option<&'a str>,
+}
+
+/// `--print-inputs`: prints what `jobs` read to stdout; returns whether every job's inputs are
+/// known (an unreadable asset or a broken folder config makes it false, named on stderr).
+pub fn print(
+    jobs: &[Job],
+    options: &[Result<Options, String>],
+    config: Option<&Path>,
+    depfile: bool,
+    format: InputsFormat,
+) -> bool {
+    let results: Vec<Result<Reads, String>> = jobs
+        .iter()
+        .zip(options)
+        .map(|(job, o)| o.clone().and_then(|o| Reads::of(job, &o, config)))
+        .collect();
+    for e in results.iter().filter_map(|r| r.as_ref().err()) {
+        eprintln!("g2tess: error: {e}");
+    }
+    let text = match format {
+        InputsFormat::Lines => {
+            let mut all: Vec<PathBuf> = results
+                .iter()
+                .flatten()
+                .flat_map(|r| r.reads.iter().cloned())
+                .collect();
+            dedupe(&mut all);
+            all.iter().map(|p| format!("{}\n", p.display())).collect()
+        }
+        InputsFormat::Json => {
+            let empty = Reads::default();
+            let records: Vec<Record> = jobs
+                .iter()
+                .zip(&results)
+                .zip(options)
+                .map(|((job, r), o)| {
+                    let mut writes = written_files(&job.output);
+                    if o.as_ref().is_ok_and(|o| o.compress && o.compress_fallback) {
+                        writes.push(fallback_path(&job.output));
+                    }
+                    if depfile {
+                        writes.push(super::depfile::path_for(&job.output));
+                    }
+                    Record {
+                        input: &job.input,
+                        output: &job.output,
+                        reads: r.as_ref().unwrap_or(&empty),
+                        writes,
+                        error: r.as_ref().err().map(String::as_str),
+                    }
+                })
+                .collect();
+            let doc = serde_json::json!({ "format": 1, "files": records });
+            let mut text = serde_json::to_string_pretty(&doc).expect("paths serialize");
+            text.push('\n');
+            text
+        }
+    };
+    print!("{text}");
+    results.iter().all(Result::is_ok)
+}
