@@ -1,4 +1,4 @@
-//! The Bazel rule of `tests/bazel/example` with the distribution's Bazel, fully offline: the
+//! The Bazel rule of `tests/buildsys/example` with the distribution's Bazel, fully offline: the
 //! example builds to the bytes a direct run gives, a second build runs nothing, a copy of the
 //! workspace in another folder is served whole from the shared cache (so no action key holds a
 //! path of the machine), a sidecar edit runs one action again, and an undeclared `.bin` is
@@ -22,7 +22,7 @@ struct Workspace {
 impl Workspace {
     /// Lays out the example in `dir` with the test's g2tess binary as `//g2tess:g2tess`.
     fn new(bazel: &Path, dir: &Path, output_base: &Path, cache: &Path) -> Workspace {
-        let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bazel/example");
+        let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/buildsys/example");
         buildsys::copy_tree(&example, dir);
         std::os::unix::fs::symlink(env!("CARGO_BIN_EXE_g2tess"), dir.join("g2tess/g2tess"))
             .unwrap();

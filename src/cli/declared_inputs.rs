@@ -85,8 +85,20 @@ impl Reads {
             reads.reads_if_created.push(folder_config);
         }
         reads.reads.extend(config.map(Path::to_path_buf));
+        for path in reads.reads.iter_mut().chain(&mut reads.reads_if_created) {
+            *path = without_dot(path);
+        }
         dedupe(&mut reads.reads);
         Ok(reads)
+    }
+}
+
+/// `./a.bin` → `a.bin`: a file beside a bare asset name is named as the user would name it,
+/// which is also how a build file names it (Make compares names as written).
+fn without_dot(path: &Path) -> PathBuf {
+    match path.strip_prefix(".") {
+        Ok(rest) if !rest.as_os_str().is_empty() => rest.to_path_buf(),
+        _ => path.to_path_buf(),
     }
 }
 
