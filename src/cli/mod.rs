@@ -124,7 +124,8 @@ pub fn run() -> i32 {
         verbosity,
         timings: args.timings,
         report: args.report.clone(),
-        depfile: args.depfile.then(|| args.config.clone()),
+        depfile: args.depfile,
+        config: args.config.clone(),
         summary_always: args.inputs.len() > 1 || args.inputs.iter().any(|i| i.is_dir()),
         status: std::cell::Cell::new(EXIT_OK),
     };
@@ -153,8 +154,10 @@ pub struct Runner<'a> {
     verbosity: Verbosity,
     timings: bool,
     report: Option<PathBuf>,
-    /// `--depfile`: write one per current output; holds `--config`, which every run reads.
-    depfile: Option<Option<PathBuf>>,
+    /// `--depfile`: write one beside each current output.
+    depfile: bool,
+    /// `--config`, which every asset's run reads.
+    config: Option<PathBuf>,
     /// Print the summary line even for a single file.
     summary_always: bool,
     /// The exit status of the last round.
@@ -177,8 +180,8 @@ impl Runner<'_> {
             interrupt::flag(),
             &progress,
         );
-        if let Some(config) = &self.depfile {
-            depfile::write_all(jobs, &options, &mut outcomes, config.as_deref());
+        if self.depfile {
+            depfile::write_all(jobs, &options, &mut outcomes, self.config.as_deref());
         }
         let summary = Summary::of(&outcomes, started);
         let show = self.summary_always && (first || jobs.len() > 1)
