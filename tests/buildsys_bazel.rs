@@ -1,8 +1,8 @@
 //! The Bazel rule of `tests/buildsys/example` with the distribution's Bazel, fully offline: the
 //! example builds to the bytes a direct run gives, a second build runs nothing, a copy of the
 //! workspace in another folder is served whole from the shared cache (so no action key holds a
-//! path of the machine), a sidecar edit runs one action again, and an undeclared `.bin` is
-//! refused by name.
+//! path of the machine), a sidecar edit runs one action again, a new sidecar runs the targets
+//! of its asset, and an undeclared `.bin` is refused by name.
 
 mod buildsys;
 mod corpus;
@@ -196,6 +196,17 @@ fn the_example_builds_caches_relocates_and_rebuilds_one_action() {
         second.build(&targets),
         Processes {
             executed: 1,
+            cached: 0
+        }
+    );
+
+    // A sidecar created where there was none is found by the macro's glob: the two targets of
+    // that asset run again, the third does not.
+    std::fs::write(second.dir.join("assets/rock.g2tess.toml"), "level = 1\n").unwrap();
+    assert_eq!(
+        second.build(&targets),
+        Processes {
+            executed: 2,
             cached: 0
         }
     );
