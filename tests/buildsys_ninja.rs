@@ -1,7 +1,7 @@
 //! The example's `build.ninja` and `Makefile` with the real `ninja` and `make`, driven by the
 //! depfiles g2tess writes: a first build runs every asset, a second runs none, and an edit to a
 //! sidecar, a `.bin` or the folder config (or deleting the sidecar) rebuilds exactly the assets
-//! made from it.
+//! made from it; names with spaces, `#` and `$` are read back from the depfile as written.
 
 mod buildsys;
 mod corpus;
@@ -98,4 +98,66 @@ fn make_rebuilds_exactly_the_assets_an_edit_touches() {
     let tmp = corpus::temp_dir();
     let dir = example(tmp.path());
     check_edits(&make, &dir, &[]);
+}
+
+/// A `.gltf` whose name holds a space, a `#` and (for Ninja) a `$`, with its `.bin` and
+/// sidecar, under `dir/lib`.
+fn awkward_asset(dir: &Path, name: &str) {
+    std::fs::create_dir_all(dir.join("lib")).unwrap();
+    buildsys::run_ok(
+        corpus::g2tess()
+            .current_dir(dir)
+            .arg(buildsys::fixture())
+            .args(["--level", "1", "-q", "-o"])
+            .arg(format!("lib/{name}.gltf")),
+    );
+    std::fs::write(dir.join(format!("lib/{name}.g2tess.toml")), "level = 2\n").unwrap();
+}
+
+/// Builds, builds again, edits the sidecar, then deletes it: 1, 0, 1, 1, 0 runs.
+fn check_awkward(tool: &Path, dir: &Path, args: &[&str], sidecar: &str) {
+    let runs = |dir: &Path| built(tool, dir, args).len();
+    assert_eq!(runs(dir), 1);
+    assert_eq!(
+        runs(dir),
+        0,
+        "the escaped depfile was not read back as written"
+    );
+    edit(&dir.join(sidecar), "level = 3\n");
+    assert_eq!(runs(dir), 1, "the sidecar's escaped name was not matched");
+    std::fs::remove_file(dir.join(sidecar)).unwrap();
+    assert_eq!(runs(dir), 1);
+    assert_eq!(runs(dir), 0);
+}
+
+#[test]
+fn ninja_reads_names_with_spaces_hashes_and_dollars_from_the_depfile() {
+    let Some(ninja) = buildsys::tool("ninja") else {
+        return;
+    };
+    let tmp = corpus::temp_dir();
+    awkward_asset(tmp.path(), "my crate#2 $x");
+    let rule = format!(
+        "rule smooth\n  command = {} --quiet --depfile $in -o $out\n  depfile = $out.d\n  deps = gcc\n\
+         build out/a$ b#$$.glb: smooth lib/my$ crate#2$ $$x.gltf\n",
+        env!("CARGO_BIN_EXE_g2tess")
+    );
+    std::fs::write(tmp.path().join("build.ninja"), rule).unwrap();
+    check_awkward(&ninja, tmp.path(), &["-v"], "lib/my crate#2 $x.g2tess.toml");
+}
+
+#[test]
+fn make_reads_names_with_spaces_and_hashes_from_the_depfile() {
+    let Some(make) = buildsys::tool("make") else {
+        return;
+    };
+    let tmp = corpus::temp_dir();
+    awkward_asset(tmp.path(), "my crate#2");
+    let rules = format!(
+        "out/a\\ b.glb: lib/my\\ crate\\#2.gltf ; {} --quiet --depfile '$<' -o '$@'\n\
+         -include out/a\\ b.glb.d\n",
+        env!("CARGO_BIN_EXE_g2tess")
+    );
+    std::fs::write(tmp.path().join("Makefile"), rules).unwrap();
+    check_awkward(&make, tmp.path(), &[], "lib/my crate#2.g2tess.toml");
 }
