@@ -180,3 +180,19 @@ pub fn print(
     print!("{text}");
     results.iter().all(Result::is_ok)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_leading_dot_folder_is_dropped_and_nothing_else() {
+        // Compared as text: `Path` equality would see past some `.` components.
+        let w = |s: &str| without_dot(Path::new(s)).to_str().unwrap().to_string();
+        assert_eq!(w("./a.bin"), "a.bin");
+        assert_eq!(w("./sub/g2tess.toml"), "sub/g2tess.toml");
+        assert_eq!(w("../a.bin"), "../a.bin");
+        assert_eq!(w("/abs/a.bin"), "/abs/a.bin");
+        assert_eq!(w("."), ".");
+    }
+}
