@@ -77,6 +77,8 @@ pub fn run() -> i32 {
         Ok(j) => j,
         Err(e) => return usage_error(&e),
     };
+    // A shard may be empty where the inputs are not.
+    let found_any = !jobs.is_empty();
     let jobs = match args.shard {
         Some(shard) => shard.select(jobs),
         None => jobs,
@@ -110,7 +112,7 @@ pub fn run() -> i32 {
         (_, true) => Verbosity::Verbose,
         _ => Verbosity::Normal,
     };
-    if jobs.is_empty() && verbosity > Verbosity::Quiet {
+    if !found_any && verbosity > Verbosity::Quiet {
         eprintln!("g2tess: no .gltf or .glb file found in the inputs");
     }
     let runner = Runner {
