@@ -34,6 +34,7 @@ pub mod coons;
 mod g2;
 pub mod hybrid;
 pub mod lattice_cache;
+pub mod nets;
 pub mod pattern;
 pub mod pn;
 pub mod profile;
@@ -45,6 +46,7 @@ use crate::mesh::TriMesh;
 use crate::topology::Topology;
 
 pub use g2::{G2Surface, PnSurface};
+pub use nets::Nets;
 pub use profile::Profile;
 pub use scheme::{build_surface, Scheme, SchemeParams};
 
