@@ -1,6 +1,6 @@
 //! The shape of the default surface against the exact shapes its coarse meshes sample: distance
 //! and normal error on a geodesic sphere and a torus at level 8 (the meshes and level of
-//! `tests/benches/shape.py`, figures of Manifold 3.5.4's `smooth_by_normals` + `refine(8)` on
+//! `tests/benches/shape/shape.py`, figures of Manifold 3.5.4's `smooth_by_normals` + `refine(8)` on
 //! the same meshes as bounds), and the normal curvature along every output edge of the
 //! icosahedron at level 16 (a unit sphere: 1 everywhere).
 
@@ -131,7 +131,7 @@ fn surface(mesh: &TriMesh, nets: Nets) -> Box<dyn Surface> {
     build_surface(Scheme::G2, mesh, &topo, &h, &params).0
 }
 
-/// Manifold 3.5.4 on the same meshes at `refine(8)` (tests/benches/shape.py): the default
+/// Manifold 3.5.4 on the same meshes at `refine(8)` (tests/benches/shape/shape.py): the default
 /// surface must be at least as close, in distance and in normals. The paper's nets must not
 /// be, so that the bound can fail.
 #[test]

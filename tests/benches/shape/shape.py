@@ -8,7 +8,7 @@ refine count, and prints a Markdown table per mesh: max and RMS distance of the 
 to the exact surface, max and RMS angle between output and exact normals, and the range of the
 normal curvature along output edges, (n_a - n_b)·(a - b)/|a - b|² (1/radius on a sphere).
 
-    python3 tests/benches/shape.py [--level 8] [--bin target/release/g2tess]
+    python3 tests/benches/shape/shape.py [--level 8] [--bin target/release/g2tess]
         [--gen ../shared/bench/gen_mesh.py] [--only NAME...] [--no-manifold]
 
 Needs numpy, and manifold3d==3.5.4 for the peer column (pip install manifold3d==3.5.4).
@@ -24,7 +24,7 @@ import tempfile
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(os.path.dirname(HERE))
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 R_MAJOR, R_MINOR = 1.0, 0.35
 
 # (name, gen_mesh shape, triangles asked for, exact surface)
@@ -187,10 +187,13 @@ def main():
                 if a.variants and label not in a.variants:
                     continue
                 out = os.path.join(tmp, "out.glb")
-                subprocess.run(
+                run = subprocess.run(
                     [a.bin, glb, "-o", out, "--level", str(a.level), *args],
-                    check=True,
+                    capture_output=True,
+                    text=True,
                 )
+                if run.returncode != 0:
+                    sys.exit(f"shape.py: g2tess {' '.join(args)} failed:\n{run.stderr}")
                 print(f"| {label} | {fmt(measure(kind, *read_glb(out)))} |", flush=True)
             if not a.no_manifold:
                 try:
