@@ -236,3 +236,57 @@ fn fairing_lowers_the_thin_plate_energy_of_every_patch() {
     let (d1, _) = distance(&faired, mesh.triangles.len(), Exact::Torus, 16);
     println!("torus 6x6 max distance: λ = 0.5 {d0:.4}, faired {d1:.4}");
 }
+
+/// Why `coons` converges slowly (max distance O(L²), normals O(L): 8.7e-4 → 9.0e-5 and 1.65° →
+/// 0.53° from the 1k to the 10k icosphere, where PN's nets give O(L⁴)): the blend of seed 002
+/// (Eq. 11) reproduces its constituents only to first order. Fed three copies of one patch `r`,
+/// it returns `r` exactly where `r` is affine, but elsewhere it is off by its auxiliary curves'
+/// Taylor remainder, `q − r(x) + Σ κ_i E_i = O(second derivatives of r)`, so on a curved surface
+/// the error shrinks like the square of the triangle's size, not like the constituents' own
+/// (O(L⁶) for round nets on a sphere). A scheme property, not a defect of this implementation.
+#[test]
+fn coons_blend_reproduces_its_constituents_to_first_order_only() {
+    use g2tess::surface::coons::patch::{point, Definition2};
+    use g2tess::surface::nets::round_net;
+    use g2tess::surface::pn::Bernstein;
+    let off = |a: f64| -> f64 {
+        // A spherical triangle `a` radians across; its round net lies on the sphere to ~a⁶/1e4.
+        let s = a.sin() / 3f64.sqrt();
+        let p = [0.0f64, 2.0, 4.0].map(|k| {
+            let phi = k * std::f64::consts::PI / 3.0;
+            DVec3::new(s * phi.cos(), s * phi.sin(), 1.0).normalize()
+        });
+        let r = round_net(p, p);
+        let mut worst: f64 = 0.0;
+        for x in [[1.0 / 3.0; 3], [0.6, 0.2, 0.2], [0.2, 0.5, 0.3]] {
+            let f = DVec3::from(point::<f64>(
+                &[r, r, r],
+                [0.5; 3],
+                x,
+                Definition2::Corrected,
+            ));
+            worst = worst.max((f - Bernstein::at(x).eval(&r)[0]).length());
+        }
+        worst
+    };
+    let flat = {
+        let p = [DVec3::ZERO, DVec3::X, DVec3::new(0.3, 0.9, 0.0)];
+        let r = round_net(p, [DVec3::Z; 3]);
+        let x = [0.2, 0.5, 0.3];
+        let f = DVec3::from(point::<f64>(
+            &[r, r, r],
+            [0.5; 3],
+            x,
+            Definition2::Corrected,
+        ));
+        (f - Bernstein::at(x).eval(&r)[0]).length()
+    };
+    let errors = [0.4, 0.2, 0.1].map(off);
+    println!("coons with three equal constituents: flat {flat:.1e}, sphere {errors:?}");
+    assert!(flat < 1e-15, "{flat}");
+    for w in errors.windows(2) {
+        // Halving the triangle divides the error by about 4 (second order), not by 64.
+        let ratio = w[0] / w[1];
+        assert!((3.0..6.0).contains(&ratio), "{errors:?}");
+    }
+}
