@@ -26,6 +26,8 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 R_MAJOR, R_MINOR = 1.0, 0.35
+# Semi-axes of the ellipsoid: the icosphere's vertices and normals mapped by diag(AXES).
+AXES = np.array([1.5, 1.0, 0.6])
 
 # (name, gen_mesh shape, triangles asked for, exact surface)
 MESHES = [
@@ -38,6 +40,8 @@ MESHES = [
     ("torus_200", "torus", 200, "torus"),
     ("torus_1k", "torus", 1000, "torus"),
     ("torus_10k", "torus", 10000, "torus"),
+    ("ellipsoid_320", "icosphere", 320, "ellipsoid"),
+    ("ellipsoid_1k", "icosphere", 1000, "ellipsoid"),
 ]
 
 # (label, g2tess arguments)
@@ -93,8 +97,44 @@ def read_glb(path):
     return np.vstack(pos), np.vstack(nrm), np.vstack(tris)
 
 
+def write_glb(path, pos, nrm, tris):
+    """A GLB of one triangle primitive (float32 POSITION with min/max and NORMAL, uint32
+    indices)."""
+    p, n = pos.astype(np.float32), nrm.astype(np.float32)
+    blobs = [p.tobytes(), n.tobytes(), tris.astype(np.uint32).tobytes()]
+    offsets = np.cumsum([0] + [len(b) for b in blobs]).tolist()
+    doc = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": len(p), "type": "VEC3",
+             "min": p.min(axis=0).tolist(), "max": p.max(axis=0).tolist()},
+            {"bufferView": 1, "componentType": 5126, "count": len(p), "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5125, "count": tris.size, "type": "SCALAR"}],
+        "bufferViews": [{"buffer": 0, "byteOffset": offsets[k], "byteLength": len(b)}
+                        for k, b in enumerate(blobs)],
+        "buffers": [{"byteLength": offsets[-1]}],
+    }
+    text = json.dumps(doc, separators=(",", ":")).encode()
+    text += b" " * (-len(text) % 4)
+    with open(path, "wb") as f:
+        f.write(struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(text) + 8 + offsets[-1]))
+        f.write(struct.pack("<I4s", len(text), b"JSON") + text)
+        f.write(struct.pack("<I4s", offsets[-1], b"BIN\0"))
+        for b in blobs:
+            f.write(b)
+
+
 def exact(kind, p):
-    """Signed distance to the exact surface and its unit normal at the nearest point."""
+    """Signed distance to the exact surface and its unit normal at the nearest point (for the
+    ellipsoid, the first-order distance F/|∇F| of its implicit form, exact to the square of the
+    figures measured)."""
+    if kind == "ellipsoid":
+        grad = 2.0 * p / AXES**2
+        f = np.sum((p / AXES) ** 2, axis=1) - 1.0
+        g = np.linalg.norm(grad, axis=1)
+        return f / g, grad / g[:, None]
     if kind == "sphere":
         r = np.linalg.norm(p, axis=1)
         return r - 1.0, p / r[:, None]
@@ -178,6 +218,10 @@ def main():
                 check=True,
                 stdout=subprocess.DEVNULL,
             )
+            if kind == "ellipsoid":
+                p, n, t = read_glb(glb)
+                n = n / AXES
+                write_glb(glb, p * AXES, n / np.linalg.norm(n, axis=1, keepdims=True), t)
             n_in = len(read_glb(glb)[2])
             print(f"\n### {name} ({n_in} triangles, {kind}), level {a.level}\n")
             print("| | max distance | RMS distance | max normal error | RMS normal error "
