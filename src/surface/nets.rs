@@ -114,7 +114,7 @@ pub fn circle_handle(p: DVec3, n: DVec3, q: DVec3, nq: DVec3) -> DVec3 {
     let m = chord.cross(n + nq);
     let t = m.cross(n);
     let t2 = t.length_squared();
-    let tangent = if t2 > 1e-24 * c2 * c2 * c2 {
+    let tangent = if t2 > 1e-20 * c2 {
         t * (t.dot(chord) / t2)
     } else {
         chord - chord.dot(n) * n
@@ -215,6 +215,28 @@ mod tests {
             assert!(r0 / r1 > 40.0 && p0 / p1 < 20.0, "{errors:?}");
         }
         assert!(errors.iter().all(|&(r, p)| r * 50.0 < p), "{errors:?}");
+    }
+
+    #[test]
+    fn handles_scale_with_the_mesh_and_stay_bounded_where_the_edge_plane_is_undefined() {
+        let (p, q) = (DVec3::new(0.1, 0.2, 0.3), DVec3::new(0.9, -0.1, 0.5));
+        let (n, nq) = (
+            DVec3::new(0.2, 0.3, 1.0).normalize(),
+            DVec3::new(-0.3, 0.1, 1.0).normalize(),
+        );
+        let unit = circle_handle(p, n, q, nq) - p;
+        for s in [1e-6, 1e6] {
+            let scaled = circle_handle(s * p, n, s * q, nq) - s * p;
+            assert!((scaled - s * unit).length() < 1e-12 * s, "{s}");
+        }
+        // Chord along both normals (no tangent plane contains any of it): no handle at all.
+        let up = DVec3::Z;
+        assert_eq!(circle_handle(DVec3::ZERO, up, up, up), DVec3::ZERO);
+        // Opposite normals (no mean normal): PN's direction, never longer than the chord.
+        let b = circle_handle(DVec3::ZERO, up, DVec3::X, -up);
+        assert!((b - DVec3::X / 3.0).length() < 1e-15, "{b}");
+        let steep = circle_handle(DVec3::ZERO, up, DVec3::new(0.1, 0.0, 1.0), -up);
+        assert!(steep.is_finite() && steep.length() < 1.01, "{steep}");
     }
 
     #[test]
