@@ -16,7 +16,9 @@
 //! - [`surface`]: the smooth surfaces over a whole mesh behind the [`surface::Surface`] trait
 //!   ([`surface::PnSurface`], [`surface::G2Surface`] (the G² blend of Lee–Hwang–Yoon), and the
 //!   `hybrid` and `coons` schemes chosen with [`surface::Scheme`]), evaluated with exact normals
-//!   at any domain point of any triangle, or over a whole lattice with cached weights.
+//!   at any domain point of any triangle, or over a whole lattice with cached weights; the
+//!   control nets under `g2` and `pn` come from [`surface::nets`] (round by default, the paper's
+//!   PN nets on request).
 //! - [`continuity`]: measures position gap, normal jump and curvature jump across edges
 //!   ([`continuity::measure`]).
 //! - [`tessellate`]: the level-n lattice of every triangle, shared edge and corner samples

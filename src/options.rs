@@ -23,6 +23,9 @@ pub const DEFAULT_CREASE_ANGLE: f64 = 60.0;
 pub const DEFAULT_PROFILE: Profile = Profile::C2;
 /// Default surface scheme.
 pub const DEFAULT_SCHEME: Scheme = Scheme::G2;
+/// Default control nets under the `g2` and `pn` schemes: circle-following edges and a
+/// side-vertex centre.
+pub const DEFAULT_NETS: Nets = Nets::Round;
 /// Default cap on output triangles per input file, so a typo in `level` cannot fill the disk or
 /// the memory: at the measured peak of about 470 bytes per output triangle (rounded up to
 /// [`crate::pipeline::PEAK_BYTES_PER_OUTPUT_TRIANGLE`]) 20 million triangles need about 10 GiB,
@@ -49,7 +52,7 @@ pub const DEFAULT_COMPRESS: bool = false;
 /// placeholder, and EXT_meshopt_compression is required to load it).
 pub const DEFAULT_COMPRESS_FALLBACK: bool = false;
 
-pub use crate::surface::{Profile, Scheme};
+pub use crate::surface::{Nets, Profile, Scheme};
 
 /// Every setting, resolved. Defaults are the `DEFAULT_*` constants of this module.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,6 +68,8 @@ pub struct Options {
     pub profile: Profile,
     /// Surface scheme. Default: [`DEFAULT_SCHEME`].
     pub scheme: Scheme,
+    /// Control nets of the `g2` and `pn` schemes. Default: [`DEFAULT_NETS`].
+    pub nets: Nets,
     /// Output triangle cap per file. Default: [`DEFAULT_MAX_OUTPUT_TRIANGLES`]; at least 1.
     pub max_output_triangles: u64,
     /// Allow `uri`s outside the asset's folder. Default: [`DEFAULT_ALLOW_OUTSIDE_URIS`].
@@ -104,6 +109,7 @@ impl Default for Options {
             crease_angle: DEFAULT_CREASE_ANGLE,
             profile: DEFAULT_PROFILE,
             scheme: DEFAULT_SCHEME,
+            nets: DEFAULT_NETS,
             max_output_triangles: DEFAULT_MAX_OUTPUT_TRIANGLES,
             allow_outside_uris: DEFAULT_ALLOW_OUTSIDE_URIS,
             overwrite_input: DEFAULT_OVERWRITE_INPUT,
@@ -130,6 +136,7 @@ pub struct ConfigFile {
     pub crease_angle: Option<f64>,
     pub profile: Option<Profile>,
     pub scheme: Option<Scheme>,
+    pub nets: Option<Nets>,
     pub max_output_triangles: Option<u64>,
     pub allow_outside_uris: Option<bool>,
     pub overwrite_input: Option<bool>,
@@ -177,6 +184,7 @@ impl Options {
             crease_angle,
             profile,
             scheme,
+            nets,
             max_output_triangles,
             allow_outside_uris,
             overwrite_input,
@@ -232,6 +240,7 @@ impl Options {
             profile: self.profile,
             lambda: self.coons_lambda,
             fair: self.coons_fair,
+            nets: self.nets,
             ..SchemeParams::default()
         }
     }

@@ -9,7 +9,7 @@ use g2tess::mesh::TriMesh;
 use g2tess::surface::coons::{Constituents, CoonsSurface, NormalMethod};
 use g2tess::surface::hybrid::HybridSurface;
 use g2tess::surface::scheme::Warning;
-use g2tess::surface::{PnSurface, SchemeParams, Surface};
+use g2tess::surface::{Nets, PnSurface, SchemeParams, Surface};
 use g2tess::topology::{self, EdgeKind, Topology};
 use support::*;
 
@@ -118,14 +118,22 @@ fn coons_is_g1_across_every_smooth_edge_with_either_constituents_and_normals() {
     }
 }
 
+/// PN is only G0: its normals jump across edges, by more than a degree on the paper's nets and
+/// still by more than a tenth of one on the round nets (whose patches lie far closer to round
+/// shapes, so that their cross-edge tangents disagree less).
 #[test]
 fn plain_pn_jumps_by_more_than_a_degree_on_the_same_meshes() {
     for (name, mesh) in meshes() {
         let topo = Topology::build(&mesh);
-        let r = measure(&PnSurface::new(&mesh, &topo), &topo);
-        println!("pn {name:22} normal jump max {:.2}°", r.normal_jump_deg.max);
-        assert!(r.gap.max <= GAP_TOL, "{name}: {r:?}");
-        assert!(r.normal_jump_deg.max > 1.0, "{name}: {r:?}");
+        for (nets, least) in [(Nets::Paper, 1.0), (Nets::Round, 0.1)] {
+            let r = measure(&PnSurface::with_nets(&mesh, &topo, nets), &topo);
+            println!(
+                "pn {nets:?} {name:22} normal jump max {:.2}°",
+                r.normal_jump_deg.max
+            );
+            assert!(r.gap.max <= GAP_TOL, "{name}: {r:?}");
+            assert!(r.normal_jump_deg.max > least, "{name} {nets:?}: {r:?}");
+        }
     }
 }
 

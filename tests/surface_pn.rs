@@ -4,7 +4,7 @@
 
 mod support;
 
-use g2tess::surface::{lattice_bary, G2Surface, PnSurface, Profile, Surface, H_MAX};
+use g2tess::surface::{lattice_bary, G2Surface, Nets, PnSurface, Profile, Surface, H_MAX};
 use g2tess::topology::Topology;
 use glam::DVec3;
 use support::*;
@@ -24,13 +24,19 @@ fn pn_reference(p: [DVec3; 3], n: [DVec3; 3], [u, v, w]: [f64; 3]) -> DVec3 {
         + 6.0 * b111 * u * v * w
 }
 
+/// On the paper's nets; on the round ones `PnSurface` is the G² surface at h = 0 just the same.
 #[test]
 fn h_zero_is_the_pn_triangle() {
     let mut rng = Lcg(3);
     for (name, mesh) in smooth_meshes() {
         let topo = Topology::build(&mesh);
-        let pn = PnSurface::new(&mesh, &topo);
-        let g2 = G2Surface::new(&mesh, &topo, &h_all(&topo, 0.0), Profile::Paper);
+        let h0 = h_all(&topo, 0.0);
+        let pn = PnSurface::with_nets(&mesh, &topo, Nets::Paper);
+        let g2 = G2Surface::with_nets(&mesh, &topo, &h0, Profile::Paper, Nets::Paper);
+        let (pn_round, g2_round) = (
+            PnSurface::new(&mesh, &topo),
+            G2Surface::new(&mesh, &topo, &h0, Profile::Paper),
+        );
         for t in 0..mesh.triangles.len() {
             let c = mesh.triangles[t].map(|i| i as usize);
             for _ in 0..10 {
@@ -45,6 +51,7 @@ fn h_zero_is_the_pn_triangle() {
                     g2.evaluate(t, l),
                     "{name}: PnSurface is the G² surface at h = 0"
                 );
+                assert_eq!(pn_round.evaluate(t, l), g2_round.evaluate(t, l), "{name}");
             }
         }
     }

@@ -53,6 +53,11 @@ pub struct Args {
     #[arg(long, value_enum, help_heading = "Surface")]
     pub scheme: Option<SchemeArg>,
 
+    /// Control nets under g2 and pn: round (circle-following) or paper (PN as published)
+    /// [default: round]
+    #[arg(long, value_enum, help_heading = "Surface")]
+    pub nets: Option<NetsArg>,
+
     /// Coons shape parameter λ of seed 002, 0.05 to 0.95 [default: 0.5]
     #[arg(long, value_name = "L", help_heading = "Surface")]
     pub coons_lambda: Option<f64>,
@@ -214,6 +219,15 @@ pub enum ProfileArg {
     C2,
 }
 
+/// `--nets` values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum NetsArg {
+    /// Edge curves that follow circular arcs, centre by a side-vertex rule
+    Round,
+    /// PN triangles as published (Vlachos et al., seed 000 Eq. 2)
+    Paper,
+}
+
 /// `--scheme` values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum SchemeArg {
@@ -266,6 +280,10 @@ impl Args {
                 SchemeArg::Pn => options::Scheme::Pn,
                 SchemeArg::Hybrid => options::Scheme::Hybrid,
                 SchemeArg::Coons => options::Scheme::Coons,
+            }),
+            nets: self.nets.map(|n| match n {
+                NetsArg::Round => options::Nets::Round,
+                NetsArg::Paper => options::Nets::Paper,
             }),
             max_output_triangles: self.max_triangles,
             allow_outside_uris: self.allow_outside_uris.then_some(true),

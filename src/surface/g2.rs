@@ -9,8 +9,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::blend::neighbour_map;
+use super::nets::Nets;
 use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights};
-use super::pn::{central_point, compose, pn_net, Net, B111, NEAR};
+use super::pn::{compose, Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint, H_MAX};
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeKind, Topology, Warning};
@@ -68,6 +69,20 @@ impl G2Surface {
     /// # Panics
     /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
     pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64], profile: Profile) -> Self {
+        Self::with_nets(mesh, topo, h_per_edge, profile, Nets::default())
+    }
+
+    /// [`G2Surface::new`] over control nets made by the rule `nets` instead of the default.
+    ///
+    /// # Panics
+    /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
+    pub fn with_nets(
+        mesh: &TriMesh,
+        topo: &Topology,
+        h_per_edge: &[f64],
+        profile: Profile,
+        nets_rule: Nets,
+    ) -> Self {
         super::assert_belong_together(mesh, topo, h_per_edge);
 
         let (h_edge, warnings) = effective_widths(topo, h_per_edge);
@@ -85,8 +100,11 @@ impl G2Surface {
                 )
             })
             .collect();
-        let mut nets: Vec<Net> = corners.par_iter().map(|&(p, n)| pn_net(p, n)).collect();
-        share_unblended_edge_curves(topo, &h_edge, &mut nets);
+        let mut nets: Vec<Net> = corners
+            .par_iter()
+            .map(|&(p, n)| nets_rule.net(p, n))
+            .collect();
+        share_unblended_edge_curves(topo, &h_edge, &mut nets, nets_rule, &corners);
 
         let patches: Vec<Patch> = corners
             .par_iter()
@@ -313,10 +331,22 @@ impl Surface for G2Surface {
 pub struct PnSurface(G2Surface);
 
 impl PnSurface {
-    /// PN triangles over `mesh`.
+    /// PN triangles over `mesh`, on the default nets.
     pub fn new(mesh: &TriMesh, topo: &Topology) -> Self {
+        Self::with_nets(mesh, topo, Nets::default())
+    }
+
+    /// PN triangles over `mesh` on nets made by the rule `nets` ([`Nets::Paper`]: Vlachos et
+    /// al. as published).
+    pub fn with_nets(mesh: &TriMesh, topo: &Topology, nets: Nets) -> Self {
         let zero = vec![0.0; topo.edges.len()];
-        PnSurface(G2Surface::new(mesh, topo, &zero, Profile::default()))
+        PnSurface(G2Surface::with_nets(
+            mesh,
+            topo,
+            &zero,
+            Profile::default(),
+            nets,
+        ))
     }
 }
 
@@ -372,8 +402,15 @@ fn effective_widths(topo: &Topology, h: &[f64]) -> (Vec<f64>, Vec<Warning>) {
 
 /// Makes every triangle along an unblended edge use one boundary curve: if their inner edge
 /// control points differ (split normals), each gets the average, oriented along the edge
-/// (PN-AEN); `b111` is then recomputed from the new edge points (Eq. 2).
-fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], nets: &mut [Net]) {
+/// (PN-AEN); `b111` is then recomputed from the new edge points by the centre rule of `rule`
+/// (Eq. 2 for the paper's nets), with each triangle's own corner normals from `corners`.
+fn share_unblended_edge_curves(
+    topo: &Topology,
+    h_edge: &[f64],
+    nets: &mut [Net],
+    rule: Nets,
+    corners: &[([DVec3; 3], [DVec3; 3])],
+) {
     let mut touched = vec![false; nets.len()];
     for (edge, &h) in topo.edges.iter().zip(h_edge) {
         if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
@@ -411,9 +448,9 @@ fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], nets: &mut [Net]
             touched[t] = true;
         }
     }
-    for (net, touched) in nets.iter_mut().zip(touched) {
+    for ((net, touched), (_, normal)) in nets.iter_mut().zip(touched).zip(corners) {
         if touched {
-            net[B111] = central_point(net);
+            net[B111] = rule.centre(net, *normal);
         }
     }
 }

@@ -6,7 +6,10 @@
 //! barycentrics) to a [`SurfacePoint`]. Per-edge widths come in already resolved.
 //!
 //! The surface of triangle f at barycentrics λ = (u, v, w):
-//! 1. `b_f`: the cubic PN triangle of Eq. 1–2 ([`pn`]), with all six edge points in `E`.
+//! 1. `b_f`: a cubic Bézier triangle (Eq. 1) from the corners' positions and normals: by
+//!    default the round net of [`nets`] (edge curves that follow circular arcs, centre by a
+//!    side-vertex rule), or the PN net of Eq. 2 ([`pn`], all six edge points in `E`) with
+//!    [`Nets::Paper`]. Everything below takes any cubic net.
 //! 2. Subdomain `k` = the smallest coordinate; the neighbour g across the edge opposite `k`
 //!    is reached by the general neighbour map `μ = Mλ` ([`blend::neighbour_map`]; Eq. 3 is
 //!    right for one labelling only).
@@ -24,7 +27,8 @@
 //! a point costs 9 dot products of length 10 outside the blending regions and of length 20
 //! inside, run for two points at a time, and no allocation. `benches/surface.rs` measures it.
 //!
-//! Module map: [`pn`] (control nets, Bernstein basis), [`profile`] (r(s)), [`blend`] (subdomain,
+//! Module map: [`nets`] (which rule makes the control nets), [`pn`] (the paper's control net,
+//! Bernstein basis, composition), [`profile`] (r(s)), [`blend`] (subdomain,
 //! t, β, neighbour map), [`pattern`] (geometry-free per-point weights, cached per lattice in a
 //! [`lattice_cache`], as the other schemes' lattice weights are), and
 //! `g2.rs` ([`G2Surface`], [`PnSurface`]: nets per triangle, combination, normals).
@@ -34,6 +38,7 @@ pub mod coons;
 mod g2;
 pub mod hybrid;
 pub mod lattice_cache;
+pub mod nets;
 pub mod pattern;
 pub mod pn;
 pub mod profile;
@@ -45,6 +50,7 @@ use crate::mesh::TriMesh;
 use crate::topology::Topology;
 
 pub use g2::{G2Surface, PnSurface};
+pub use nets::Nets;
 pub use profile::Profile;
 pub use scheme::{build_surface, Scheme, SchemeParams};
 

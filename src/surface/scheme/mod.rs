@@ -27,7 +27,7 @@ use crate::topology::{self, EdgeId, Topology};
 
 use super::coons::{Constituents, CoonsSurface};
 use super::hybrid::HybridSurface;
-use super::{G2Surface, PnSurface, Profile, Surface};
+use super::{G2Surface, Nets, PnSurface, Profile, Surface};
 
 /// A surface construction.
 #[derive(
@@ -107,6 +107,8 @@ pub struct SchemeParams {
     pub fair: bool,
     /// Coons: the edge surfaces blended. Default value: [`Constituents::FoleyOpitz`].
     pub constituents: Constituents,
+    /// Control nets of the G² and PN schemes. Default value: [`Nets::Round`].
+    pub nets: Nets,
 }
 
 impl SchemeParams {
@@ -122,6 +124,7 @@ impl Default for SchemeParams {
             lambda: Self::DEFAULT_LAMBDA,
             fair: false,
             constituents: Constituents::default(),
+            nets: Nets::default(),
         }
     }
 }
@@ -164,11 +167,14 @@ pub fn build_surface(
 ) -> (Box<dyn Surface>, Vec<Warning>) {
     match scheme {
         Scheme::G2 => {
-            let s = G2Surface::new(mesh, topo, h_per_edge, params.profile);
+            let s = G2Surface::with_nets(mesh, topo, h_per_edge, params.profile, params.nets);
             let w = s.warnings().iter().cloned().map(Warning::Edges).collect();
             (Box::new(s), w)
         }
-        Scheme::Pn => (Box::new(PnSurface::new(mesh, topo)), Vec::new()),
+        Scheme::Pn => (
+            Box::new(PnSurface::with_nets(mesh, topo, params.nets)),
+            Vec::new(),
+        ),
         Scheme::Hybrid => {
             let s = HybridSurface::new(mesh, topo, h_per_edge);
             let w = s.warnings().to_vec();
