@@ -34,13 +34,33 @@ pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<Fi
     let started = Instant::now();
     let (mut report, files) = encode_file(input, output, options)?;
     let write_start = Instant::now();
-    for file in &files {
-        file.write_atomically()
-            .map_err(|e| Error::gltf(output, e))?;
-    }
+    gltf_io::write_files_atomically(&files).map_err(|e| Error::gltf(output, e))?;
     report.times.write += write_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// Every file that processing `asset` under `options` reads: the asset, the buffer and image
+/// files it refers to (as [`gltf_io::referenced_files`] resolves them), and its sidecar (the
+/// one named by `--sidecar`, else the one beside it, listed whether or not it exists, since
+/// creating it changes the result). Skipping up-to-date outputs, watching, and refusing an
+/// output that would replace another asset's input all start from this list.
+///
+/// Never fails: an unreadable asset is listed alone, and processing it reports why.
+pub fn files_read(asset: &Path, options: &Options) -> Vec<std::path::PathBuf> {
+    let mut files = vec![asset.to_path_buf()];
+    files.extend(gltf_io::referenced_files(asset, options.allow_outside_uris));
+    files.push(match &options.sidecar {
+        Some(s) => s.clone(),
+        None => crate::sharpness::sidecar_path_for(asset),
+    });
+    files
+}
+
+/// Every file that [`process_file`] may write for `output` under `options` (the output, a
+/// `.gltf`'s `.bin`, a compressed output's fallback buffer), by name, before any is written.
+pub fn files_written(output: &Path, options: &Options) -> Vec<std::path::PathBuf> {
+    gltf_io::output_files(output, options.compression())
 }
 
 /// Does everything [`process_file`] does except writing: returns the files it would write
