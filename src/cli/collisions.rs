@@ -91,11 +91,9 @@ mod tests {
 
     #[test]
     fn a_shared_fallback_buffer_is_refused_naming_both_inputs() {
-        let compressed = Options {
-            compress: true,
-            compress_fallback: true,
-            ..Options::default()
-        };
+        let mut compressed = Options::default();
+        compressed.compress = true;
+        compressed.compress_fallback = true;
         let jobs = [job("in/x.glb", "out/x.glb"), job("in/x.gltf", "out/x.gltf")];
         let opts = [Ok(compressed.clone()), Ok(compressed)];
         let e = check(&jobs, &opts).unwrap_err();
