@@ -17,7 +17,6 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use g2tess::sharpness::SIDECAR_SUFFIX;
 use notify::{PollWatcher, RecommendedWatcher, RecursiveMode};
 use notify_debouncer_mini::{new_debouncer_opt, Config, DebounceEventResult, Debouncer};
 
@@ -139,7 +138,9 @@ pub fn run(runner: &Runner, scope: &Scope, jobs: Vec<Job>, settings: WatchSettin
 struct State {
     /// Every asset seen, by input path.
     known: BTreeMap<PathBuf, Job>,
-    /// A buffer, image or sidecar file (absolute) → the assets made from it.
+    /// A buffer, image or sidecar file (absolute) → the assets made from it: every file
+    /// [`g2tess::pipeline::files_read`] lists but the asset, sidecars that do not exist yet
+    /// included (so a new sidecar is a change of its asset).
     users: HashMap<PathBuf, BTreeSet<PathBuf>>,
     /// Each path's size and time (absolute; `None`: absent) when it was last read or looked
     /// at. Reading a file is an event too (notify reports opens), so an event on a path whose
@@ -216,16 +217,6 @@ impl State {
             }
             if name == DIR_CONFIG {
                 add(scope.jobs_at(parent_dir(&path)), &mut changed);
-            } else if let Some(stem) = name.strip_suffix(SIDECAR_SUFFIX) {
-                let dir = parent_dir(&path);
-                let assets = ["gltf", "glb", "GLTF", "GLB"]
-                    .iter()
-                    .map(|e| dir.join(format!("{stem}.{e}")))
-                    .filter(|a| a.is_file());
-                add(
-                    assets.filter_map(|a| scope.job_for(&a)).collect(),
-                    &mut changed,
-                );
             } else if path.is_dir() {
                 add(scope.jobs_at(&path), &mut changed);
             } else if path.is_file() && is_asset_name(&path) {

@@ -8,6 +8,7 @@
 //! - [`glb`]: the GLB container
 //! - [`uri`]: `data:` and file `uri`s, bounded to the asset's folder
 //! - [`meshopt_decode`]: EXT_/KHR_meshopt_compression buffer views
+//! - [`draco_decode`]: KHR_draco_mesh_compression primitives, decoded to plain arrays
 //! - [`mod@quantize`]: KHR_mesh_quantization of every mesh ([`Quantization`])
 //! - [`dequantize_nodes`]: the node transforms that undo position quantization, on write
 //! - [`meshopt_encode`]: EXT_meshopt_compression of the written views ([`Compression`])
@@ -26,6 +27,7 @@ mod bounds;
 mod buffer_data;
 pub mod dequantize_nodes;
 pub mod document;
+pub mod draco_decode;
 pub mod error;
 pub mod files;
 pub mod glb;

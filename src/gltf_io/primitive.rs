@@ -3,8 +3,8 @@
 //! one back as new accessors.
 //!
 //! It deliberately keeps everything about the primitive it does not understand (material,
-//! extensions, extras) and refuses Draco-compressed primitives rather than reading their
-//! placeholder accessors, which hold zeros.
+//! extensions, extras). A Draco-compressed primitive is decoded from its stream
+//! ([`super::draco_decode`]), never from its placeholder accessors, which hold no data.
 
 use gltf_json::accessor::{ComponentType, GenericComponentType, Type};
 use gltf_json::mesh::Mode;
@@ -15,6 +15,7 @@ use super::accessor::{self, component_size, vector_type};
 use super::bounds;
 use super::buffer_data::BufferData;
 use super::document::{Document, ReadOptions};
+use super::draco_decode;
 use super::error::{Error, Result};
 use super::validate::is_triangle_mode;
 
@@ -178,32 +179,67 @@ impl Document {
         let json = self
             .primitive_json(mesh, prim)
             .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
-        if let Some(ext) = json.get("extensions").and_then(Value::as_object) {
-            if let Some(name) = ext
-                .keys()
-                .find(|k| k.as_str() == "KHR_draco_mesh_compression")
-            {
-                return Err(Error::unsupported(
-                    format!("{at}.extensions.{name}"),
-                    "draco-compressed geometry cannot be decoded by this tool (expected uncompressed or meshopt-compressed data)",
-                ));
-            }
-        }
         let max =
             ReadOptions::DEFAULT_MAX_BYTES.max(self.buffers.iter().map(|b| b.len() as u64).sum());
-        let attributes = read_attributes(
-            self,
-            json.get("attributes"),
-            &format!("{at}.attributes"),
-            false,
-            max,
-        )?;
-        let vertices = attributes.first().map_or(0, Attribute::count);
-        let list: Vec<u32> = match json.get("indices") {
-            Some(i) => accessor::read(self, index_of(i, &format!("{at}.indices"))?, max)?.to_u32(),
-            None => (0..vertices as u32).collect(),
+        let draco = json.pointer(&format!("/extensions/{}", draco_decode::EXTENSION));
+        let (attributes, list) = match draco {
+            Some(ext) => {
+                let decoded = draco_decode::read(self, json, ext, &at)?;
+                let mut attributes = Vec::with_capacity(decoded.attributes.len());
+                for slot in decoded.attributes {
+                    let a = match slot {
+                        draco_decode::Slot::Decoded(a) => a,
+                        draco_decode::Slot::Accessor(name) => {
+                            let one = json.get("attributes").and_then(|a| a.get(&name));
+                            let single = one.map(|i| json!({ name.clone(): i }));
+                            let mut read = read_attributes(
+                                self,
+                                single.as_ref(),
+                                &format!("{at}.attributes"),
+                                false,
+                                max,
+                            )?;
+                            let a = read.pop().expect("one attribute read");
+                            if a.count() != decoded.points {
+                                return Err(Error::invalid(
+                                    format!("{at}.attributes.{name}"),
+                                    format!(
+                                        "has {} elements, the Draco stream {} points (expected one per point)",
+                                        a.count(),
+                                        decoded.points
+                                    ),
+                                ));
+                            }
+                            a
+                        }
+                    };
+                    attributes.push(a);
+                }
+                (attributes, decoded.indices)
+            }
+            None => {
+                let attributes = read_attributes(
+                    self,
+                    json.get("attributes"),
+                    &format!("{at}.attributes"),
+                    false,
+                    max,
+                )?;
+                let vertices = attributes.first().map_or(0, Attribute::count);
+                let list: Vec<u32> = match json.get("indices") {
+                    Some(i) => {
+                        accessor::read(self, index_of(i, &format!("{at}.indices"))?, max)?.to_u32()
+                    }
+                    None => (0..vertices as u32).collect(),
+                };
+                (attributes, list)
+            }
         };
-        let mode = json.get("mode").and_then(Value::as_u64).unwrap_or(4);
+        // A Draco stream holds its faces as a triangle list whatever the mode says.
+        let mode = match draco {
+            Some(_) => 4,
+            None => json.get("mode").and_then(Value::as_u64).unwrap_or(4),
+        };
         let indices = match mode {
             4 => list[..list.len() - list.len() % 3].to_vec(),
             5 => (0..list.len().saturating_sub(2))
@@ -308,6 +344,13 @@ pub fn replace_primitive_owned(
         .cloned()
         .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
     collect_accessor_refs(&json, &mut doc.replaced_accessors);
+    // The new data is written uncompressed: the Draco stream no longer describes it.
+    if let Some(ext) = json.get_mut("extensions").and_then(Value::as_object_mut) {
+        ext.remove(draco_decode::EXTENSION);
+        if ext.is_empty() {
+            json.as_object_mut().map(|o| o.remove("extensions"));
+        }
+    }
     let vertices = data.vertex_count();
     let index_bounds = bounds::uint_bounds(&data.indices);
     if let Some((_, bad)) = index_bounds.filter(|(_, hi)| *hi as usize >= vertices) {

@@ -17,7 +17,7 @@ use super::document::Document;
 use super::error::{Error, Result};
 use super::files::{bin_path, fallback_path};
 use super::meshopt_encode::{self, Compression};
-use super::{dequantize_nodes, glb, json_merge, meshopt_decode, uri};
+use super::{dequantize_nodes, draco_decode, glb, json_merge, meshopt_decode, uri};
 
 /// How to write.
 #[derive(Debug, Clone, Default)]
@@ -740,12 +740,25 @@ fn fix_extension_lists(root: &mut Map<String, Value>) {
     if quantized {
         add_extension(root, "KHR_mesh_quantization", true);
     }
+    // Primitives decoded from Draco are written uncompressed; the others keep their stream.
+    let draco = root
+        .get("meshes")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .filter_map(|m| m.get("primitives").and_then(Value::as_array))
+        .flatten()
+        .any(|p| {
+            p.pointer(&format!("/extensions/{}", draco_decode::EXTENSION))
+                .is_some()
+        });
     for key in ["extensionsUsed", "extensionsRequired"] {
         if let Some(list) = root.get_mut(key).and_then(Value::as_array_mut) {
             list.retain(|e| {
                 let name = e.as_str().unwrap_or("");
                 !meshopt_decode::EXTENSIONS.contains(&name)
                     && (quantized || name != "KHR_mesh_quantization")
+                    && (draco || name != draco_decode::EXTENSION)
             });
             if list.is_empty() {
                 root.remove(key);
