@@ -35,12 +35,27 @@ pub(super) fn read(doc: &Document, prim: &Value, ext: &Value, at: &str) -> Resul
             )
         })?;
     let stream = doc.view_bytes(view as usize)?;
-    let mesh = draco::decode_mesh(stream).map_err(|e| {
-        Error::invalid(
-            &ext_at,
-            format!("the Draco stream cannot be decoded: {e} (expected a Draco 2.2 mesh stream)"),
-        )
-    })?;
+    // The decoder is a pre-release: some malformed streams make it panic instead of returning
+    // an error. Either way the file is refused with an error naming the primitive (the panic's
+    // own message still reaches the panic hook).
+    let decoded = std::panic::catch_unwind(|| draco::decode_mesh(stream));
+    let mesh = match decoded {
+        Ok(Ok(mesh)) => mesh,
+        Ok(Err(e)) => {
+            return Err(Error::invalid(
+                &ext_at,
+                format!(
+                    "the Draco stream cannot be decoded: {e} (expected a Draco 2.2 mesh stream)"
+                ),
+            ))
+        }
+        Err(_) => {
+            return Err(Error::invalid(
+                &ext_at,
+                "the Draco stream cannot be decoded: the decoder gave up on it (expected a valid Draco 2.2 mesh stream)",
+            ))
+        }
+    };
     let ids = ext
         .get("attributes")
         .and_then(Value::as_object)
