@@ -45,7 +45,8 @@ pub use error::{Error, ErrorKind, Result};
 pub use files::{fallback_path, output_files, referenced_files};
 pub use meshopt_encode::Compression;
 pub use primitive::{
-    replace_primitive, replace_primitive_owned, Attribute, PrimitiveData, PrimitiveSize, Values,
+    replace_primitive, replace_primitive_owned, semantic, Attribute, MorphDeltas, PrimitiveData,
+    PrimitiveSize, Values,
 };
 pub use quantize::{quantize, Quantization};
 pub use write::{

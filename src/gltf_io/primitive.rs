@@ -63,6 +63,80 @@ impl Attribute {
     pub fn count(&self) -> usize {
         self.values.len() / self.components.max(1)
     }
+
+    /// A new float attribute, written as 32-bit floats.
+    pub fn float(name: &str, components: usize, values: Vec<f32>) -> Attribute {
+        Attribute {
+            name: name.to_string(),
+            components,
+            values: Values::Float(values),
+            component_type: ComponentType::F32,
+            normalized: false,
+        }
+    }
+
+    /// Its values as float 3-vectors, if that is what it holds.
+    pub fn vec3(&self) -> Option<&[f32]> {
+        match &self.values {
+            Values::Float(v) if self.components == 3 => Some(v),
+            _ => None,
+        }
+    }
+}
+
+/// The glTF attribute names the tool gives a meaning to, and the rules that pair attributes:
+/// the only place outside reading and writing that spells them.
+pub mod semantic {
+    /// Vertex positions.
+    pub const POSITION: &str = "POSITION";
+    /// Vertex normals.
+    pub const NORMAL: &str = "NORMAL";
+    /// Vertex tangents (xyz and the handedness w).
+    pub const TANGENT: &str = "TANGENT";
+
+    /// The texture coordinate set `set`.
+    pub fn texcoord(set: u32) -> String {
+        format!("TEXCOORD_{set}")
+    }
+
+    /// The skin weights paired with the joint indices `joints` (`JOINTS_n` → `WEIGHTS_n`).
+    pub fn weights_of(joints: &str) -> Option<String> {
+        joints
+            .strip_prefix("JOINTS_")
+            .map(|set| format!("WEIGHTS_{set}"))
+    }
+
+    /// The joint indices paired with the skin weights `weights` (`WEIGHTS_n` → `JOINTS_n`).
+    pub fn joints_of(weights: &str) -> Option<String> {
+        weights
+            .strip_prefix("WEIGHTS_")
+            .map(|set| format!("JOINTS_{set}"))
+    }
+}
+
+/// One morph target's displacements of the core arrays.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct MorphDeltas<'a> {
+    /// Position deltas, 3 per vertex.
+    pub positions: Option<&'a [f32]>,
+    /// Normal deltas, 3 per vertex.
+    pub normals: Option<&'a [f32]>,
+}
+
+impl<'a> MorphDeltas<'a> {
+    /// The position and normal deltas of morph target `target` (other attributes ignored).
+    pub fn of(target: &'a [Attribute]) -> Self {
+        let find = |name: &str| {
+            target
+                .iter()
+                .find(|a| a.name == name)
+                .and_then(Attribute::vec3)
+        };
+        MorphDeltas {
+            positions: find(semantic::POSITION),
+            normals: find(semantic::NORMAL),
+        }
+    }
 }
 
 /// A triangle primitive as arrays: attributes, a triangle list, morph targets.
@@ -84,7 +158,67 @@ impl PrimitiveData {
 
     /// Number of vertices (of POSITION).
     pub fn vertex_count(&self) -> usize {
-        self.attribute("POSITION").map_or(0, Attribute::count)
+        self.attribute(semantic::POSITION)
+            .map_or(0, Attribute::count)
+    }
+
+    /// The positions, 3 floats per vertex, all finite; the error names the primitive at JSON
+    /// path `at`.
+    pub fn positions(&self, at: &str) -> Result<&[f32]> {
+        let positions = match self.attribute(semantic::POSITION) {
+            Some(a) if a.components == 3 => match &a.values {
+                Values::Float(v) => v,
+                Values::Uint(_) => unreachable!("positions are decoded as floats"),
+            },
+            Some(a) => {
+                return Err(Error::invalid(
+                    format!("{at}.attributes.POSITION"),
+                    format!("has {} components (expected 3)", a.components),
+                ))
+            }
+            None => {
+                return Err(Error::invalid(
+                    format!("{at}.attributes"),
+                    "has no POSITION (expected a triangle primitive with positions)",
+                ))
+            }
+        };
+        if let Some(i) = positions.iter().position(|x| !x.is_finite()) {
+            return Err(Error::invalid(
+                format!("{at}.attributes.POSITION"),
+                format!("vertex {} is not finite (expected finite numbers)", i / 3),
+            ));
+        }
+        Ok(positions)
+    }
+
+    /// The normals, 3 floats per vertex, if the primitive has float normals.
+    pub fn normals(&self) -> Option<&[f32]> {
+        self.attribute(semantic::NORMAL).and_then(Attribute::vec3)
+    }
+
+    /// The tangents, if the primitive has them.
+    pub fn tangents(&self) -> Option<&Attribute> {
+        self.attribute(semantic::TANGENT)
+    }
+
+    /// The skin weights paired with the joint indices `joints`, when the pair is what skinning
+    /// reads (4 integer joints, 4 float weights, one each per vertex).
+    pub fn skin_weights(&self, joints: &Attribute) -> Option<&Attribute> {
+        let weights = self.attribute(&semantic::weights_of(&joints.name)?)?;
+        let paired = matches!(joints.values, Values::Uint(_))
+            && matches!(weights.values, Values::Float(_))
+            && joints.components == 4
+            && weights.values.len() == joints.values.len();
+        paired.then_some(weights)
+    }
+
+    /// Whether `weights` is paired with joint indices (see [`PrimitiveData::skin_weights`]
+    /// for the rule: checked from the joints' side).
+    pub fn is_paired_weights(&self, weights: &str) -> bool {
+        semantic::joints_of(weights)
+            .and_then(|j| self.attribute(&j))
+            .is_some_and(|j| matches!(j.values, Values::Uint(_)) && j.components == 4)
     }
 }
 
@@ -116,6 +250,16 @@ impl Document {
                 .get("primitives")?
                 .get(prim)
         })
+    }
+
+    /// The texture coordinate set of the normal texture of primitive `prim` of mesh `mesh`'s
+    /// material, if it has one.
+    pub fn normal_texture_set(&self, mesh: usize, prim: usize) -> Option<u32> {
+        self.root.meshes[mesh].primitives[prim]
+            .material
+            .and_then(|m| self.root.materials.get(m.value()))
+            .and_then(|m| m.normal_texture.as_ref())
+            .map(|t| t.tex_coord)
     }
 
     /// Every (mesh, primitive) whose mode is a triangle list, strip or fan, in file order.

@@ -247,13 +247,9 @@ fn raw_extras(doc: &Document, collection: &[&str], index: usize) -> Option<Value
 /// normal texture (a renderer would otherwise derive them per pixel from screen derivatives,
 /// which no longer match a bake against the low-poly mesh).
 fn needs_tangents(doc: &Document, mesh: usize, prim: usize, data: &PrimitiveData) -> Option<u32> {
-    let normal_texture = doc.root.meshes[mesh].primitives[prim]
-        .material
-        .and_then(|m| doc.root.materials.get(m.value()))
-        .and_then(|m| m.normal_texture.as_ref());
-    match normal_texture {
-        Some(t) => Some(t.tex_coord),
-        None if data.attribute("TANGENT").is_some() => Some(0),
+    match doc.normal_texture_set(mesh, prim) {
+        Some(set) => Some(set),
+        None if data.tangents().is_some() => Some(0),
         None => None,
     }
 }
