@@ -36,9 +36,8 @@ pub(super) fn read(doc: &Document, prim: &Value, ext: &Value, at: &str) -> Resul
         })?;
     let stream = doc.view_bytes(view as usize)?;
     // The decoder is a pre-release: some malformed streams make it panic instead of returning
-    // an error. Either way the file is refused with an error naming the primitive (the panic's
-    // own message still reaches the panic hook).
-    let decoded = std::panic::catch_unwind(|| draco::decode_mesh(stream));
+    // an error. Either way the file is refused with an error naming the primitive.
+    let decoded = quietly(|| draco::decode_mesh(stream));
     let mesh = match decoded {
         Ok(Ok(mesh)) => mesh,
         Ok(Err(e)) => {
@@ -194,6 +193,30 @@ pub(super) struct Decoded {
     pub indices: Vec<u32>,
     /// The decoded point count (every attribute has one value per point).
     pub points: usize,
+}
+
+thread_local! {
+    /// Set while this thread runs the decoder: its panics are expected and reported as errors.
+    static DECODING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `decode`, turning a panic into `Err(())` without printing it: the panic hook in place
+/// (the default one prints a message) is wrapped once so that it stays silent for a panic on a
+/// thread inside `decode` and is called as before for every other panic.
+fn quietly<T>(decode: impl FnOnce() -> T) -> std::result::Result<T, ()> {
+    static WRAP: std::sync::Once = std::sync::Once::new();
+    WRAP.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !DECODING.with(std::cell::Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    DECODING.with(|d| d.set(true));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode));
+    DECODING.with(|d| d.set(false));
+    result.map_err(|_| ())
 }
 
 /// The values of a decoded attribute per point (Draco stores each distinct value once and maps
