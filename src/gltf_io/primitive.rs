@@ -252,6 +252,18 @@ impl Document {
         })
     }
 
+    /// The `extras` of mesh `mesh` as plain JSON, if any.
+    pub fn mesh_extras(&self, mesh: usize) -> Option<Value> {
+        self.raw.pointer(&format!("/meshes/{mesh}/extras")).cloned()
+    }
+
+    /// The `extras` of primitive `prim` of mesh `mesh` as plain JSON, if any.
+    pub fn primitive_extras(&self, mesh: usize, prim: usize) -> Option<Value> {
+        self.raw
+            .pointer(&format!("/meshes/{mesh}/primitives/{prim}/extras"))
+            .cloned()
+    }
+
     /// The texture coordinate set of the normal texture of primitive `prim` of mesh `mesh`'s
     /// material, if it has one.
     pub fn normal_texture_set(&self, mesh: usize, prim: usize) -> Option<u32> {

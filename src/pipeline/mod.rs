@@ -19,7 +19,6 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use serde_json::Value;
 
 use crate::gltf_io::{self, Document, PrimitiveData, WriteOptions};
 use crate::options::Options;
@@ -168,17 +167,14 @@ fn mesh_inputs(doc: &Document, asset: &Path) -> Result<Vec<MeshInput>, Error> {
             inputs.push(MeshInput {
                 mesh,
                 name: doc.root.meshes[mesh].name.clone(),
-                extras: raw_extras(doc, &["meshes"], mesh),
+                extras: doc.mesh_extras(mesh),
                 primitives: Vec::new(),
             });
         }
         let current = inputs.last_mut().expect("pushed above");
         current.primitives.push(mesh_job::PrimitiveInput {
             index: prim,
-            extras: doc
-                .raw
-                .pointer(&format!("/meshes/{mesh}/primitives/{prim}/extras"))
-                .cloned(),
+            extras: doc.primitive_extras(mesh, prim),
             needs_tangents: needs_tangents(doc, mesh, prim, &data),
             data,
         });
@@ -235,12 +231,6 @@ pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<Str
         .map(ToString::to_string)
         .chain(warnings)
         .collect())
-}
-
-/// The `extras` of `collection[index]` as plain JSON, if any.
-fn raw_extras(doc: &Document, collection: &[&str], index: usize) -> Option<Value> {
-    let pointer = format!("/{}/{index}/extras", collection.join("/"));
-    doc.raw.pointer(&pointer).cloned()
 }
 
 /// Tangents are regenerated when the input had them, or when the primitive's material has a
