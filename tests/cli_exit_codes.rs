@@ -143,3 +143,65 @@ fn output_is_deterministic() {
     }
     assert_eq!(std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
 }
+
+#[test]
+fn an_output_name_without_an_asset_extension_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.txt");
+    let run = corpus::g2tess()
+        .arg(example())
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("-o names neither a .glb nor a .gltf file"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_missing_sidecar_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = corpus::g2tess()
+        .arg(example())
+        .arg("-o")
+        .arg(dir.path().join("o.glb"))
+        .arg("--sidecar")
+        .arg(dir.path().join("none.g2tess.toml"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{err}");
+    assert!(err.contains("--sidecar: no such file"), "{err}");
+}
+
+#[test]
+fn a_folder_config_range_error_names_its_line_and_each_asset() {
+    let dir = tempfile::tempdir().unwrap();
+    let tree = dir.path().join("tree");
+    std::fs::create_dir_all(tree.join("sub")).unwrap();
+    std::fs::copy(example(), tree.join("a.glb")).unwrap();
+    std::fs::copy(example(), tree.join("sub/b.glb")).unwrap();
+    let config = tree.join("g2tess.toml");
+    std::fs::write(&config, "# settings\n\nlevel = 99\n").unwrap();
+    let run = corpus::g2tess()
+        .arg(&tree)
+        .arg("-o")
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{err}");
+    for asset in ["a.glb", "sub/b.glb"] {
+        let line = format!(
+            "g2tess: error: {}: not processed: {}:3: level: is 99",
+            tree.join(asset).display(),
+            config.display()
+        );
+        assert_eq!(err.matches(&line).count(), 1, "{line}\n{err}");
+    }
+}

@@ -268,3 +268,42 @@ fn polling_sees_changes_too() {
     assert!(out.join("a.glb").is_file());
     assert_eq!(w.interrupt(), Some(0), "{}", w.log());
 }
+
+#[test]
+fn a_broken_input_is_tried_again_only_when_it_or_a_file_it_reads_changes() {
+    let dir = corpus::temp_dir();
+    let tree = dir.path().join("tree");
+    std::fs::create_dir_all(&tree).unwrap();
+    std::fs::copy(example(), tree.join("a.glb")).unwrap();
+    let out = dir.path().join("out");
+    let mut w = Watcher::start(&[
+        tree.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--level".as_ref(),
+        "1".as_ref(),
+        "--watch".as_ref(),
+        "-v".as_ref(),
+        "--debounce".as_ref(),
+        "100".as_ref(),
+    ]);
+    let broken = format!("g2tess: error: {}: ", tree.join("b.glb").display());
+    let errors = |log: &str| log.matches(&broken).count();
+    std::fs::write(tree.join("b.glb"), b"garbage").unwrap();
+    w.wait_for("the error", |log| errors(log) == 1);
+    // Reading it again is no change: no second attempt, and no round at all (under -v a
+    // round of the good file would say "up to date, skipped").
+    std::thread::sleep(Duration::from_millis(1500));
+    assert_eq!(errors(&w.log()), 1, "{}", w.log());
+    assert!(!w.log().contains("up to date, skipped"), "{}", w.log());
+    // A file it reads (its sidecar) changes: one more attempt.
+    std::fs::write(tree.join("b.g2tess.toml"), "level = 2\n").unwrap();
+    w.wait_for("the retry", |log| errors(log) == 2);
+    std::thread::sleep(Duration::from_millis(1500));
+    assert_eq!(errors(&w.log()), 2, "{}", w.log());
+    // Fixed: processed.
+    std::fs::copy(example(), tree.join("b.glb")).unwrap();
+    w.wait_for("the fix", |_| out.join("b.glb").is_file());
+    w.assert_alive();
+    assert_eq!(w.interrupt(), Some(0), "{}", w.log());
+}

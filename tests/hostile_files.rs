@@ -291,3 +291,51 @@ fn inputs_are_never_modified() {
     let after = [snapshot(&input), snapshot(&root.path().join("t.bin"))];
     assert_eq!(before, after);
 }
+
+#[test]
+fn full_disk_keeps_the_previous_gltf_and_bin_together() {
+    let root = corpus::temp_dir();
+    // A small mesh with a large JSON part (40 KB of extras, carried to the output): the `.bin`
+    // fits under the file-size limit and the `.gltf` does not, so the `.bin` would be renamed
+    // into place first if the two were not replaced as a set.
+    let input = write_tetrahedron(root.path(), "t.gltf", "t.bin", Some(Path::new("t.bin")));
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&input).unwrap()).unwrap();
+    json["extras"] = serde_json::json!({ "pad": "x".repeat(40_000) });
+    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let out_dir = root.path().join("out");
+    let out = out_dir.join("t.gltf");
+    let level = |l: &'static str| {
+        [
+            os(&input),
+            "-o".as_ref(),
+            os(&out),
+            "--level".as_ref(),
+            l.as_ref(),
+        ]
+    };
+    assert_eq!(g2tess(&level("1")).code, Some(0));
+    let previous = (
+        std::fs::read(&out).unwrap(),
+        std::fs::read(out_dir.join("t.bin")).unwrap(),
+    );
+    assert!(previous.1.len() < 20 * 512 && previous.0.len() > 40 * 512);
+    // 40 blocks of 512 bytes: the new level-2 `.bin` fits, the `.gltf` does not.
+    let run = run_limited(&level("2"), Some(40));
+    assert_eq!(verdict(&run), None, "{run:?}");
+    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    assert!(run.stderr.contains("file too large"), "{}", run.stderr);
+    let now = (
+        std::fs::read(&out).unwrap(),
+        std::fs::read(out_dir.join("t.bin")).unwrap(),
+    );
+    assert!(
+        now == previous,
+        "the previous .gltf and .bin were not kept together"
+    );
+    assert_eq!(
+        tree(&out_dir),
+        BTreeSet::from([PathBuf::from("t.gltf"), PathBuf::from("t.bin")]),
+        "a temporary file was left"
+    );
+}

@@ -62,6 +62,11 @@ impl Outcome {
         }
     }
 
+    /// Not started.
+    pub fn cancelled() -> Outcome {
+        Outcome::new(Status::Cancelled)
+    }
+
     fn failed(error: String) -> Outcome {
         Outcome {
             error: Some(error),

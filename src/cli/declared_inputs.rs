@@ -10,14 +10,12 @@
 
 use std::path::{Path, PathBuf};
 
-use g2tess::gltf_io::write::fallback_path;
 use g2tess::options::Options;
-use g2tess::sharpness::sidecar_path_for;
 use serde::Serialize;
 
 use super::args::InputsFormat;
 use super::dir_config::{searched_dirs, DIR_CONFIG};
-use super::manifest::{companions, written_files};
+use super::manifest::written_files;
 use super::scope::Job;
 
 /// What one asset's run reads.
@@ -35,13 +33,14 @@ pub struct Reads {
 /// and the knowledge of companions, sidecars and folder configs. `None` when the asset cannot
 /// be read (the run would fail on it).
 fn discover(job: &Job, options: &Options) -> Option<Discovered> {
-    let bytes = std::fs::read(&job.input).ok()?;
+    std::fs::File::open(&job.input).ok()?;
+    // The asset first, then its buffers and images, then the sidecar it would use.
+    let mut files = g2tess::pipeline::files_read(&job.input, options);
+    let sidecar = files.pop()?;
+    let companions = files.split_off(1);
     Some(Discovered {
-        companions: companions(&job.input, &bytes, options.allow_outside_uris),
-        sidecar: options
-            .sidecar
-            .clone()
-            .map_or_else(|| (sidecar_path_for(&job.input), false), |s| (s, true)),
+        companions,
+        sidecar: (sidecar, options.sidecar.is_some()),
         folder_configs: searched_dirs(job)
             .into_iter()
             .map(|d| d.join(DIR_CONFIG))
@@ -155,10 +154,12 @@ pub fn print(
                 .zip(&results)
                 .zip(options)
                 .map(|((job, r), o)| {
-                    let mut writes = written_files(&job.output);
-                    if o.as_ref().is_ok_and(|o| o.compress && o.compress_fallback) {
-                        writes.push(fallback_path(&job.output));
-                    }
+                    let mut writes = match o {
+                        Ok(o) => g2tess::pipeline::files_written(&job.output, o),
+                        Err(_) => written_files(&job.output),
+                    };
+                    // The output first, then the files written beside it.
+                    writes.sort_by_key(|w| *w != job.output);
                     if depfile {
                         writes.push(super::depfile::path_for(&job.output));
                     }

@@ -32,8 +32,15 @@ impl<'a> DirConfigs<'a> {
         }
     }
 
-    /// The options of `job`'s asset; the error is a message naming the config file and line.
+    /// The options of `job`'s asset; the error is a message naming the asset, then the config
+    /// file and line (each asset below a broken config fails with it, and the report and the
+    /// log say which assets were not processed).
     pub fn options(&mut self, job: &Job) -> Result<Options, String> {
+        self.resolve(job)
+            .map_err(|e| format!("{}: not processed: {e}", job.input.display()))
+    }
+
+    fn resolve(&mut self, job: &Job) -> Result<Options, String> {
         let Some((file, config)) = self.nearest(job)? else {
             return self.layers.resolve(None).map_err(|e| e.to_string());
         };
@@ -78,6 +85,30 @@ fn read(file: &Path) -> Option<Result<ConfigFile, String>> {
     Some(
         std::fs::read_to_string(file)
             .map_err(|e| format!("{shown}: {}", e.to_string().to_lowercase()))
-            .and_then(|text| ConfigFile::parse(&text, &shown).map_err(|e| e.to_string())),
+            .and_then(|text| {
+                let config = ConfigFile::parse(&text, &shown).map_err(|e| e.to_string())?;
+                check_ranges(&config, &text, &shown)?;
+                Ok(config)
+            }),
     )
+}
+
+/// Range-checks the settings a folder config sets on their own, so that an error names the
+/// line of the key (a range error found later, once layered, names only the file).
+fn check_ranges(config: &ConfigFile, text: &str, shown: &str) -> Result<(), String> {
+    let Err(e) = Options::default().overlay(config).validate(shown) else {
+        return Ok(());
+    };
+    let key = e.at.strip_prefix(shown).and_then(|k| k.strip_prefix(": "));
+    let line = key.and_then(|key| {
+        text.lines().position(|l| {
+            l.trim_start()
+                .strip_prefix(key)
+                .is_some_and(|rest| rest.trim_start().starts_with('='))
+        })
+    });
+    Err(match (key, line) {
+        (Some(key), Some(line)) => format!("{shown}:{}: {key}: {}", line + 1, e.what),
+        _ => e.to_string(),
+    })
 }

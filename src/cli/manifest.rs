@@ -1,7 +1,7 @@
 //! Incremental runs: a small manifest beside the outputs (`.g2tess-manifest.json` in the `-o`
 //! folder; named output files and outputs beside their inputs have none) records, per output, a
-//! hash of everything its input consisted of (the asset, its buffer and image files, its
-//! sidecar) and a hash of the effective settings, with the size and modification time of each
+//! hash of everything its input consisted of (the files [`pipeline::files_read`] lists: the
+//! asset, its buffer and image files, its sidecar) and a hash of the effective settings, with the size and modification time of each
 //! file written. An output is skipped when both hashes and its files are unchanged.
 //!
 //! Contents are hashed rather than timestamps compared, because checkouts, copies and archive
@@ -12,13 +12,11 @@ use std::collections::BTreeMap;
 use std::hash::Hasher as _;
 use std::path::{Path, PathBuf};
 
-use g2tess::gltf_io::{glb, uri};
 use g2tess::options::Options;
-use g2tess::sharpness::sidecar_path_for;
+use g2tess::pipeline;
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 
-use super::scope::{parent_dir, Job};
+use super::scope::Job;
 
 /// The manifest's file name in each output folder.
 pub const MANIFEST_NAME: &str = ".g2tess-manifest.json";
@@ -34,30 +32,27 @@ pub struct Fingerprint {
     pub settings: String,
     /// Every file hashed into `inputs`, as the asset's path names them (for watching).
     pub files: Vec<PathBuf>,
+    /// Each of `files`' size and time just before it was read (`None`: absent).
+    pub stamps: Vec<Option<Stamp>>,
+    /// Every file the output may consist of.
+    pub written: Vec<PathBuf>,
 }
 
 impl Fingerprint {
-    /// Reads and hashes what `job` is made of under `options`. Never fails: an unreadable file
-    /// hashes as absent, and the pipeline reports why it cannot be read.
+    /// Reads and hashes what `job` is made of under `options` (the files
+    /// [`pipeline::files_read`] lists). Never fails: an unreadable file hashes as absent, and
+    /// the pipeline reports why it cannot be read.
+    ///
+    /// Each file's [`Stamp`] is taken before it is read, so that a change made while the job
+    /// runs shows as a change afterwards.
     pub fn of(job: &Job, options: &Options) -> Fingerprint {
-        let mut files = vec![job.input.clone()];
-        let bytes = std::fs::read(&job.input).ok();
-        if let Some(bytes) = &bytes {
-            files.extend(companions(&job.input, bytes, options.allow_outside_uris));
-        }
-        files.push(match &options.sidecar {
-            Some(s) => s.clone(),
-            None => sidecar_path_for(&job.input),
-        });
+        let files = pipeline::files_read(&job.input, options);
+        let mut stamps = Vec::with_capacity(files.len());
         let mut h = fnv::FnvHasher::default();
-        for (i, file) in files.iter().enumerate() {
+        for file in &files {
+            stamps.push(Stamp::of(file));
             h.write(file.file_name().unwrap_or_default().as_encoded_bytes());
-            let content = if i == 0 {
-                bytes.as_deref().map(hash)
-            } else {
-                std::fs::read(file).ok().map(|b| hash(&b))
-            };
-            match content {
+            match std::fs::read(file).ok().map(|b| hash(&b)) {
                 Some(c) => h.write_u64(c),
                 None => h.write(b"\0absent"),
             }
@@ -71,6 +66,8 @@ impl Fingerprint {
             inputs: format!("{:016x}", h.finish()),
             settings: format!("{:016x}", hash(settings.as_bytes())),
             files,
+            stamps,
+            written: pipeline::files_written(&job.output, options),
         }
     }
 }
@@ -81,31 +78,8 @@ fn hash(bytes: &[u8]) -> u64 {
     h.finish()
 }
 
-/// The buffer and image files a `.gltf` or `.glb` refers to, in document order.
-pub(super) fn companions(asset: &Path, bytes: &[u8], allow_outside: bool) -> Vec<PathBuf> {
-    let json = match glb::is_glb(bytes) {
-        true => glb::split(bytes).map(|c| c.json).unwrap_or_default(),
-        false => bytes,
-    };
-    let Ok(root) = serde_json::from_slice::<Value>(json) else {
-        return Vec::new();
-    };
-    let base = parent_dir(asset);
-    ["buffers", "images"]
-        .iter()
-        .filter_map(|k| root.get(*k).and_then(Value::as_array))
-        .flatten()
-        .filter_map(|o| o.get("uri").and_then(Value::as_str))
-        .filter_map(
-            |u| match uri::resolve(u, "uri", Some(base), allow_outside) {
-                Ok(uri::Target::File(f)) => Some(f),
-                _ => None,
-            },
-        )
-        .collect()
-}
-
-/// One written file: enough to notice that someone replaced or removed it.
+/// One file's size and modification time: enough to notice that someone replaced or removed
+/// it, read without opening it (opening a file is itself an event to a watcher).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Stamp {
     pub size: u64,
@@ -192,12 +166,12 @@ impl Manifests {
             return;
         };
         let mut outputs = BTreeMap::new();
-        for file in written_files(&job.output) {
+        for file in &fp.written {
             // A `.gltf` without binary data has no `.bin`.
-            if let Some(stamp) = Stamp::of(&file) {
+            if let Some(stamp) = Stamp::of(file) {
                 let name = file
                     .strip_prefix(dir)
-                    .unwrap_or(&file)
+                    .unwrap_or(file)
                     .to_string_lossy()
                     .replace(std::path::MAIN_SEPARATOR, "/");
                 outputs.insert(name, stamp);
@@ -241,16 +215,11 @@ impl Manifests {
     }
 }
 
-/// The files writing `output` may create: the output, and a `.gltf`'s `.bin`.
+/// Every file writing `output` may create under any settings (for telling outputs from
+/// inputs, and removing the outputs of a deleted input).
 pub fn written_files(output: &Path) -> Vec<PathBuf> {
-    let mut files = vec![output.to_path_buf()];
-    let gltf = output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
-    if gltf {
-        files.push(output.with_extension("bin"));
-    }
-    files
+    let any = g2tess::gltf_io::Compression::new(true);
+    g2tess::gltf_io::output_files(output, Some(any))
 }
 
 #[cfg(test)]

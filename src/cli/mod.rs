@@ -9,6 +9,7 @@
 
 mod args;
 mod batch;
+mod collisions;
 mod declared_inputs;
 mod depfile;
 mod dir_config;
@@ -29,7 +30,7 @@ use clap::Parser;
 use batch::{Outcome, RunSettings, Summary};
 use dir_config::DirConfigs;
 use manifest::Manifests;
-use progress::{Progress, Verbosity};
+use progress::{say, Progress, Verbosity};
 use scope::{Job, Scope};
 
 /// Every input processed.
@@ -61,6 +62,13 @@ pub fn run() -> i32 {
         Ok(l) => l,
         Err(e) => return usage_error(&e.to_string()),
     };
+    if let Some(sidecar) = args.sidecar.as_deref().filter(|s| !s.is_file()) {
+        return usage_error(&format!(
+            "{}: --sidecar: no such file (expected a sidecar such as <asset>{})",
+            sidecar.display(),
+            g2tess::sharpness::SIDECAR_SUFFIX
+        ));
+    }
     if let Some(mesh) = &args.explain_h {
         return explain_h(&args.inputs, &layers, mesh);
     }
@@ -73,12 +81,15 @@ pub fn run() -> i32 {
         Ok(s) => s,
         Err(e) => return usage_error(&e),
     };
-    let jobs = match scope.jobs() {
+    let (jobs, unreadable) = match scope.jobs() {
         Ok(j) => j,
         Err(e) => return usage_error(&e),
     };
     // A shard may be empty where the inputs are not.
     let found_any = !jobs.is_empty();
+    // Collisions are checked over every input found, so that shards cannot write over each
+    // other's files either.
+    let all_jobs = jobs.clone();
     let jobs = match args.shard {
         Some(shard) => shard.select(jobs),
         None => jobs,
@@ -112,8 +123,14 @@ pub fn run() -> i32 {
         (_, true) => Verbosity::Verbose,
         _ => Verbosity::Normal,
     };
-    if !found_any && verbosity > Verbosity::Quiet {
-        eprintln!("g2tess: no .gltf or .glb file found in the inputs");
+    for problem in &unreadable {
+        if problem.is_error || verbosity > Verbosity::Quiet {
+            say(&problem.to_string());
+        }
+    }
+    let unreadable = unreadable.iter().any(|p| p.is_error);
+    if !found_any && !unreadable && verbosity > Verbosity::Quiet {
+        say("g2tess: no .gltf or .glb file found in the inputs");
     }
     let runner = Runner {
         layers: &layers,
@@ -140,12 +157,15 @@ pub fn run() -> i32 {
         return watch::run(&runner, &scope, jobs, settings);
     }
     let mut manifests = Manifests::load(&jobs);
-    runner.round(&jobs, &mut manifests, true);
-    runner.status.get()
+    runner.round(&jobs, &all_jobs, &mut manifests, true);
+    match unreadable {
+        false => runner.status.get(),
+        true => runner.status.get().max(EXIT_SOME_FAILED),
+    }
 }
 
 fn usage_error(message: &str) -> i32 {
-    eprintln!("g2tess: error: {message}");
+    say(&format!("g2tess: error: {message}"));
     EXIT_USAGE
 }
 
@@ -168,11 +188,24 @@ pub struct Runner<'a> {
 
 impl Runner<'_> {
     /// Processes `jobs` (reading folder configs afresh), prints, saves the manifests, writes
-    /// the report; sets [`Runner::status`].
-    pub fn round(&self, jobs: &[Job], manifests: &mut Manifests, first: bool) -> Vec<Outcome> {
+    /// the report; sets [`Runner::status`]. `context` is every job of the run (`jobs` among
+    /// them): when the files some of them write collide (see [`collisions`]), nothing is
+    /// processed, the status is [`EXIT_USAGE`] and every outcome is `Cancelled`.
+    pub fn round(
+        &self,
+        jobs: &[Job],
+        context: &[Job],
+        manifests: &mut Manifests,
+        first: bool,
+    ) -> Vec<Outcome> {
         let started = Instant::now();
         let mut configs = DirConfigs::new(self.layers);
         let options: Vec<_> = jobs.iter().map(|j| configs.options(j)).collect();
+        let context_options: Vec<_> = context.iter().map(|j| configs.options(j)).collect();
+        if let Err(e) = collisions::check(context, &context_options) {
+            self.status.set(usage_error(&e));
+            return jobs.iter().map(|_| Outcome::cancelled()).collect();
+        }
         let progress = Progress::new(jobs.len(), self.verbosity, self.timings);
         let mut outcomes = batch::run(
             jobs,
@@ -201,7 +234,7 @@ impl Runner<'_> {
             let written =
                 report::write(file, jobs, &outcomes, &summary, self.settings.check, status);
             if let Err(e) = written {
-                eprintln!("g2tess: error: {e}");
+                say(&format!("g2tess: error: {e}"));
                 status = status.max(EXIT_SOME_FAILED);
             }
         }
@@ -215,28 +248,42 @@ impl Runner<'_> {
             return;
         }
         if let Err(e) = manifests.save() {
-            eprintln!("g2tess: warning: {e}: the next run will process every file again");
+            say(&format!(
+                "g2tess: warning: {e}: the next run will process every file again"
+            ));
         }
     }
 }
 
 /// `--explain-h MESH`: prints, per input, which source set each edge's h; writes nothing.
+///
+/// A closed stdout (`| head`) ends it quietly with the status so far: the reader has what it
+/// wanted.
 fn explain_h(inputs: &[PathBuf], layers: &args::Layers, mesh: &str) -> i32 {
+    use std::io::Write as _;
     let options = match layers.resolve(None) {
         Ok(o) => o,
         Err(e) => return usage_error(&e.to_string()),
     };
     let mut status = EXIT_OK;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     for input in inputs {
         match g2tess::pipeline::explain_h(input, &options, mesh) {
             Ok(lines) => {
-                println!("{}: mesh {mesh}", input.display());
-                for line in lines {
-                    println!("  {line}");
+                let written = writeln!(out, "{}: mesh {mesh}", input.display())
+                    .and_then(|()| lines.iter().try_for_each(|l| writeln!(out, "  {l}")))
+                    .and_then(|()| out.flush());
+                match written {
+                    Ok(()) => {}
+                    Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return status,
+                    Err(e) => {
+                        say(&format!("g2tess: error: standard output: {e}"));
+                        return EXIT_SOME_FAILED;
+                    }
                 }
             }
             Err(e) => {
-                eprintln!("g2tess: error: {e}");
+                say(&format!("g2tess: error: {e}"));
                 status = EXIT_SOME_FAILED;
             }
         }

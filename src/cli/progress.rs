@@ -3,7 +3,7 @@
 //!
 //! It deliberately prints nothing on stdout, which stays free for the caller.
 
-use std::io::IsTerminal as _;
+use std::io::{IsTerminal as _, Write as _};
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -55,7 +55,7 @@ impl Progress {
     pub fn line(&self, text: &str) {
         match &self.bar {
             Some(bar) => bar.println(text),
-            None => eprintln!("{text}"),
+            None => say(text),
         }
     }
 
@@ -123,8 +123,15 @@ impl Progress {
         if self.verbosity == Verbosity::Quiet || !show {
             return;
         }
-        eprintln!("g2tess: {}", summary_line(summary, check));
+        say(&format!("g2tess: {}", summary_line(summary, check)));
     }
+}
+
+/// Prints a line on stderr. A stderr that cannot be written to (a closed pipe: `2>&1 | head`)
+/// ends what is printed, never the run: the files still get processed and the exit status
+/// still tells how it went.
+pub fn say(text: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{text}");
 }
 
 /// `12 done, 30 skipped, 1 failed; 1234 -> 19744 triangles; 1.2 MB -> 5.6 MB; 1.23 s`.

@@ -92,6 +92,13 @@ impl Scope {
                 }
                 Target::Folder(o.to_path_buf())
             }
+            Some(o) if !is_asset_name(o) => {
+                return Err(format!(
+                    "{}: -o names neither a .glb nor a .gltf file (expected e.g. -o {})",
+                    o.display(),
+                    o.with_extension("glb").display()
+                ))
+            }
             Some(o) => Target::File(o.to_path_buf()),
         };
         let out_abs = match &target {
@@ -109,6 +116,18 @@ impl Scope {
                         "{}: the output folder is the input folder (expected another folder, e.g. -o {})",
                         input.display(),
                         input.join("smooth").display()
+                    ));
+                }
+                if abs.starts_with(out) {
+                    // Every input would count as an output of the run (and a later run would
+                    // take the outputs for inputs).
+                    return Err(format!(
+                        "{}: the output folder {} contains the input folder (expected an output folder outside it, e.g. -o {})",
+                        input.display(),
+                        output.unwrap_or(Path::new(".")).display(),
+                        Path::new("build")
+                            .join(input.file_name().unwrap_or_default())
+                            .display()
                     ));
                 }
                 output_inside = out.strip_prefix(&abs).ok().map(Path::to_path_buf);
@@ -152,18 +171,20 @@ impl Scope {
         })
     }
 
-    /// Every job of the run, in input order and sorted within each folder. The message is a
-    /// usage error (two inputs that would write one output).
-    pub fn jobs(&self) -> Result<Vec<Job>, String> {
-        let mut jobs = Vec::new();
+    /// Every job of the run, in input order and sorted within each folder, and what the walk
+    /// could not read. The message is a usage error (two inputs that would write one output).
+    pub fn jobs(&self) -> Result<(Vec<Job>, Vec<Problem>), String> {
+        let (mut jobs, mut problems) = (Vec::new(), Vec::new());
         for (i, root) in self.roots.iter().enumerate() {
             if root.is_dir {
-                jobs.extend(self.walk(i, &root.path));
+                let (found, issues) = self.walk(i, &root.path);
+                jobs.extend(found);
+                problems.extend(issues);
             } else {
                 jobs.push(self.job(i, &root.path));
             }
         }
-        dedupe(jobs)
+        Ok((dedupe(jobs)?, problems))
     }
 
     /// The jobs of the assets at or below `path` (a file or a folder) that this run covers.
@@ -179,7 +200,11 @@ impl Scope {
             }
             if path.is_dir() {
                 if path.starts_with(&root.path) && self.admits_dir(i, path) {
-                    jobs.extend(self.walk(i, path));
+                    let (found, problems) = self.walk(i, path);
+                    jobs.extend(found);
+                    for p in problems {
+                        super::progress::say(&p.to_string());
+                    }
                 }
             } else if path.starts_with(&root.path) && self.admits_file(i, path) {
                 jobs.push(self.job(i, path));
@@ -219,15 +244,39 @@ impl Scope {
         }
     }
 
-    fn walk(&self, root: usize, dir: &Path) -> Vec<Job> {
+    /// The jobs below `dir`, and what could not be read. Links are followed (a linked asset
+    /// or folder counts as if it were there); a link back to a folder above it is not.
+    fn walk(&self, root: usize, dir: &Path) -> (Vec<Job>, Vec<Problem>) {
         let walk = walkdir::WalkDir::new(dir)
+            .follow_links(true)
             .sort_by_file_name()
             .into_iter()
-            .filter_entry(|e| !e.file_type().is_dir() || self.admits_dir(root, e.path()));
-        walk.filter_map(Result::ok)
-            .filter(|e| e.file_type().is_file() && self.admits_file(root, e.path()))
-            .map(|e| self.job(root, e.path()))
-            .collect()
+            .filter_entry(|e| !e.file_type().is_dir() || self.admits_dir(root, e.path()))
+            .map(|entry| {
+                entry
+                    .map(|e| (e.file_type().is_file(), e.into_path()))
+                    .map_err(|e| WalkIssue::from(&e))
+            });
+        self.sort_walk(root, walk)
+    }
+
+    /// Splits a walk into the jobs of its admitted files and its problems.
+    fn sort_walk(
+        &self,
+        root: usize,
+        entries: impl Iterator<Item = Result<(bool, PathBuf), WalkIssue>>,
+    ) -> (Vec<Job>, Vec<Problem>) {
+        let (mut jobs, mut problems) = (Vec::new(), Vec::new());
+        for entry in entries {
+            match entry {
+                Ok((true, path)) if self.admits_file(root, &path) => {
+                    jobs.push(self.job(root, &path))
+                }
+                Ok(_) => {}
+                Err(issue) => problems.extend(issue.problem()),
+            }
+        }
+        (jobs, problems)
     }
 
     /// Whether the walk enters `dir` (below folder input `root`): not the output folder, not
@@ -285,6 +334,75 @@ impl Scope {
             manifest_dir,
             key,
         }
+    }
+}
+
+/// Something a folder walk could not read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Problem {
+    /// The message, naming the path.
+    pub message: String,
+    /// An error (the run's status is at least 1), or only a warning.
+    pub is_error: bool,
+}
+
+impl std::fmt::Display for Problem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kind = if self.is_error { "error" } else { "warning" };
+        write!(f, "g2tess: {kind}: {}", self.message)
+    }
+}
+
+/// A failed step of a folder walk, in the terms that decide what to do about it.
+#[derive(Debug, Clone)]
+struct WalkIssue {
+    path: Option<PathBuf>,
+    /// The folder a link loops back to.
+    loop_to: Option<PathBuf>,
+    kind: Option<std::io::ErrorKind>,
+    what: String,
+}
+
+impl From<&walkdir::Error> for WalkIssue {
+    fn from(e: &walkdir::Error) -> Self {
+        WalkIssue {
+            path: e.path().map(Path::to_path_buf),
+            loop_to: e.loop_ancestor().map(Path::to_path_buf),
+            kind: e.io_error().map(std::io::Error::kind),
+            what: e
+                .io_error()
+                .map_or_else(|| e.to_string(), ToString::to_string)
+                .to_lowercase(),
+        }
+    }
+}
+
+impl WalkIssue {
+    /// A folder that cannot be read is an error (its assets would be missing silently); a
+    /// link loop is a warning (the folder it leads to is walked anyway); a dangling link is an
+    /// error only when it is named like an asset.
+    fn problem(&self) -> Option<Problem> {
+        let shown = self
+            .path
+            .as_deref()
+            .map_or_else(|| "?".into(), |p| p.display().to_string());
+        if let Some(to) = &self.loop_to {
+            return Some(Problem {
+                message: format!("{shown}: a link back to {}, not followed", to.display()),
+                is_error: false,
+            });
+        }
+        let dangling = self.kind == Some(std::io::ErrorKind::NotFound);
+        if dangling && !self.path.as_deref().is_some_and(is_asset_name) {
+            return None;
+        }
+        Some(Problem {
+            message: match dangling {
+                true => format!("{shown}: a link to a missing file (expected an asset)"),
+                false => format!("{shown}: cannot read: {}", self.what),
+            },
+            is_error: true,
+        })
     }
 }
 
@@ -405,6 +523,37 @@ mod tests {
         let s = set(&["props/**"]);
         assert!(s.is_match("props/a.glb") && !s.is_match("x/props/a.glb"));
         assert!(!set(&["props/*.glb"]).is_match("props/sub/a.glb"));
+    }
+
+    #[test]
+    fn an_unreadable_folder_is_an_error_naming_it_and_the_walk_goes_on() {
+        let scope = Scope::new(&["in".into()], Some(Path::new("out/")), &[], &[]).unwrap();
+        let denied = WalkIssue {
+            path: Some("in/locked".into()),
+            loop_to: None,
+            kind: Some(std::io::ErrorKind::PermissionDenied),
+            what: "permission denied (os error 13)".into(),
+        };
+        let looped = WalkIssue {
+            path: Some("in/sub/up".into()),
+            loop_to: Some("in".into()),
+            kind: None,
+            what: String::new(),
+        };
+        let entries = vec![
+            Err(denied),
+            Ok((true, PathBuf::from("in/a.glb"))),
+            Err(looped),
+        ];
+        let (jobs, problems) = scope.sort_walk(0, entries.into_iter());
+        assert_eq!(jobs.len(), 1);
+        assert_eq!(
+            problems.iter().map(ToString::to_string).collect::<Vec<_>>(),
+            [
+                "g2tess: error: in/locked: cannot read: permission denied (os error 13)",
+                "g2tess: warning: in/sub/up: a link back to in, not followed"
+            ]
+        );
     }
 
     #[test]

@@ -7,21 +7,23 @@
 //! editor's save by temporary file and rename shows up as a few paths, and every path is looked
 //! at again on disk, so what the events were called does not matter. A file whose size still
 //! changes is waited for. The tool's own outputs, temporary files and manifests are never taken
-//! for changes, even when the output folder is inside a watched one.
+//! for changes, even when the output folder is inside a watched one, and neither is its own
+//! reading of a file (notify reports opens): a path counts as changed only when its size or
+//! modification time differs from when it was last read, so an input that failed is tried
+//! again only once it, or a file it reads, has changed.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use g2tess::sharpness::SIDECAR_SUFFIX;
 use notify::{PollWatcher, RecommendedWatcher, RecursiveMode};
 use notify_debouncer_mini::{new_debouncer_opt, Config, DebounceEventResult, Debouncer};
 
 use super::batch::Outcome;
 use super::dir_config::DIR_CONFIG;
-use super::manifest::{written_files, Manifests};
-use super::progress::Verbosity;
+use super::manifest::{written_files, Manifests, Stamp};
+use super::progress::{say, Verbosity};
 use super::scope::{absolute, is_asset_name, parent_dir, Job, Scope};
 use super::{interrupt, Runner, EXIT_OK, EXIT_USAGE};
 
@@ -58,7 +60,7 @@ pub struct WatchSettings {
 pub fn run(runner: &Runner, scope: &Scope, jobs: Vec<Job>, settings: WatchSettings) -> i32 {
     let mut manifests = Manifests::load(&jobs);
     let mut state = State::default();
-    let outcomes = runner.round(&jobs, &mut manifests, true);
+    let outcomes = runner.round(&jobs, &jobs, &mut manifests, true);
     state.learn(&jobs, &outcomes);
 
     let (tx, rx) = mpsc::channel::<Wake>();
@@ -72,7 +74,7 @@ pub fn run(runner: &Runner, scope: &Scope, jobs: Vec<Job>, settings: WatchSettin
     let _watcher = match start(scope, settings, tx) {
         Ok(w) => w,
         Err(e) => {
-            eprintln!("g2tess: error: {e}");
+            say(&format!("g2tess: error: {e}"));
             return EXIT_USAGE;
         }
     };
@@ -82,16 +84,16 @@ pub fn run(runner: &Runner, scope: &Scope, jobs: Vec<Job>, settings: WatchSettin
         .map(|(p, _)| p.display().to_string())
         .collect();
     if runner.verbosity > Verbosity::Quiet {
-        eprintln!(
+        say(&format!(
             "g2tess: watching {} for changes (Ctrl-C to stop)",
             shown.join(", ")
-        );
+        ));
     }
     while let Ok(wake) = rx.recv() {
         let mut paths = match wake {
             Wake::Stop => break,
             Wake::Error(e) => {
-                eprintln!("g2tess: error: watching: {e}");
+                say(&format!("g2tess: error: watching: {e}"));
                 continue;
             }
             Wake::Changes(p) => p,
@@ -102,7 +104,7 @@ pub fn run(runner: &Runner, scope: &Scope, jobs: Vec<Job>, settings: WatchSettin
             match more {
                 Wake::Changes(p) => paths.extend(p),
                 Wake::Stop => stopping = true,
-                Wake::Error(e) => eprintln!("g2tess: error: watching: {e}"),
+                Wake::Error(e) => say(&format!("g2tess: error: watching: {e}")),
             }
         }
         if stopping || interrupt::requested() {
@@ -114,7 +116,8 @@ pub fn run(runner: &Runner, scope: &Scope, jobs: Vec<Job>, settings: WatchSettin
         }
         if !changed.is_empty() {
             wait_until_stable(&changed);
-            let outcomes = runner.round(&changed, &mut manifests, false);
+            let context = state.context(&changed);
+            let outcomes = runner.round(&changed, &context, &mut manifests, false);
             state.learn(&changed, &outcomes);
         } else if !deleted.is_empty() {
             runner.save(&mut manifests);
@@ -125,7 +128,7 @@ pub fn run(runner: &Runner, scope: &Scope, jobs: Vec<Job>, settings: WatchSettin
     }
     runner.save(&mut manifests);
     if runner.verbosity > Verbosity::Quiet {
-        eprintln!("g2tess: stopped watching");
+        say("g2tess: stopped watching");
     }
     EXIT_OK
 }
@@ -135,14 +138,27 @@ pub fn run(runner: &Runner, scope: &Scope, jobs: Vec<Job>, settings: WatchSettin
 struct State {
     /// Every asset seen, by input path.
     known: BTreeMap<PathBuf, Job>,
-    /// A buffer, image or sidecar file (absolute) → the assets made from it.
+    /// A buffer, image or sidecar file (absolute) → the assets made from it: every file
+    /// [`g2tess::pipeline::files_read`] lists but the asset, sidecars that do not exist yet
+    /// included (so a new sidecar is a change of its asset).
     users: HashMap<PathBuf, BTreeSet<PathBuf>>,
+    /// Each path's size and time (absolute; `None`: absent) when it was last read or looked
+    /// at. Reading a file is an event too (notify reports opens), so an event on a path whose
+    /// stamp is unchanged is the tool's own reading, not a change: without this, every round
+    /// would cause the next, and a broken input would be retried forever.
+    seen: HashMap<PathBuf, Option<Stamp>>,
 }
 
 impl State {
     fn learn(&mut self, jobs: &[Job], outcomes: &[Outcome]) {
         for (job, outcome) in jobs.iter().zip(outcomes) {
             self.known.insert(job.input.clone(), job.clone());
+            if let Some(fp) = &outcome.fingerprint {
+                for (file, stamp) in fp.files.iter().zip(&fp.stamps) {
+                    // Taken just before the job read the file: a later change differs.
+                    self.seen.insert(absolute(file), *stamp);
+                }
+            }
             for file in outcome
                 .fingerprint
                 .iter()
@@ -153,7 +169,32 @@ impl State {
                     .or_default()
                     .insert(job.input.clone());
             }
+            // The folder configs the round read (each round reads them afresh).
+            for dir in parent_dir(&job.input).ancestors() {
+                let config = absolute(&dir.join(DIR_CONFIG));
+                self.seen.entry(config).or_insert_with_key(|c| Stamp::of(c));
+                if dir == job.config_root || dir.as_os_str().is_empty() {
+                    break;
+                }
+            }
         }
+    }
+
+    /// Every job of the run as far as the watcher knows, `changed` included: the files they
+    /// write and read must not collide.
+    fn context(&self, changed: &[Job]) -> Vec<Job> {
+        let mut all = self.known.clone();
+        for job in changed {
+            all.insert(job.input.clone(), job.clone());
+        }
+        all.into_values().collect()
+    }
+
+    /// Whether `path` differs from when it was last seen (and remembers it as it is now).
+    fn is_changed(&mut self, path: &Path) -> bool {
+        let now = Stamp::of(path);
+        let before = self.seen.insert(absolute(path), now);
+        before != Some(now)
     }
 
     /// The jobs to run again and the jobs whose input is gone, for these changed paths.
@@ -166,7 +207,7 @@ impl State {
             }
         };
         for path in paths.iter().filter_map(|p| scope.given_form(p)) {
-            if scope.is_own(&path) {
+            if scope.is_own(&path) || !self.is_changed(&path) {
                 continue;
             }
             let name = path.file_name().unwrap_or_default().to_string_lossy();
@@ -176,16 +217,6 @@ impl State {
             }
             if name == DIR_CONFIG {
                 add(scope.jobs_at(parent_dir(&path)), &mut changed);
-            } else if let Some(stem) = name.strip_suffix(SIDECAR_SUFFIX) {
-                let dir = parent_dir(&path);
-                let assets = ["gltf", "glb", "GLTF", "GLB"]
-                    .iter()
-                    .map(|e| dir.join(format!("{stem}.{e}")))
-                    .filter(|a| a.is_file());
-                add(
-                    assets.filter_map(|a| scope.job_for(&a)).collect(),
-                    &mut changed,
-                );
             } else if path.is_dir() {
                 add(scope.jobs_at(&path), &mut changed);
             } else if path.is_file() && is_asset_name(&path) {
@@ -218,7 +249,9 @@ fn remove_outputs(runner: &Runner, job: &Job, delete: bool, manifests: &mut Mani
     let output = job.output.display();
     if !delete {
         if runner.verbosity > Verbosity::Quiet {
-            eprintln!("g2tess: {input} was deleted; {output} is kept (pass --delete to remove it)");
+            say(&format!(
+                "g2tess: {input} was deleted; {output} is kept (pass --delete to remove it)"
+            ));
         }
         return;
     }
@@ -227,15 +260,18 @@ fn remove_outputs(runner: &Runner, job: &Job, delete: bool, manifests: &mut Mani
         match std::fs::remove_file(&file) {
             Ok(()) => {
                 if runner.verbosity > Verbosity::Quiet {
-                    eprintln!("g2tess: {input} was deleted; removed {}", file.display());
+                    say(&format!(
+                        "g2tess: {input} was deleted; removed {}",
+                        file.display()
+                    ));
                 }
             }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => eprintln!(
+            Err(e) => say(&format!(
                 "g2tess: error: {}: cannot remove: {}",
                 file.display(),
                 e.to_string().to_lowercase()
-            ),
+            )),
         }
     }
 }

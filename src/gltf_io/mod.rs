@@ -8,6 +8,7 @@
 //! - [`glb`]: the GLB container
 //! - [`uri`]: `data:` and file `uri`s, bounded to the asset's folder
 //! - [`meshopt_decode`]: EXT_/KHR_meshopt_compression buffer views
+//! - [`draco_decode`]: KHR_draco_mesh_compression primitives, decoded to plain arrays
 //! - [`mod@quantize`]: KHR_mesh_quantization of every mesh ([`Quantization`])
 //! - [`dequantize_nodes`]: the node transforms that undo position quantization, on write
 //! - [`meshopt_encode`]: EXT_meshopt_compression of the written views ([`Compression`])
@@ -16,6 +17,7 @@
 //! - [`primitive`]: [`PrimitiveData`] out of and back into a document
 //! - [`json_merge`]: keeps what the typed JSON model loses
 //! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically, streamed from the buffers in memory
+//! - [`files`]: the files an asset reads and the files an output consists of, by name
 //! - `bounds`: accessor `min`/`max`, in parallel
 //! - `buffer_data`: buffers held in the element type they were made in, shared with the writer
 //! - [`error`]: [`Error`], located by JSON path
@@ -25,7 +27,9 @@ mod bounds;
 mod buffer_data;
 pub mod dequantize_nodes;
 pub mod document;
+pub mod draco_decode;
 pub mod error;
+pub mod files;
 pub mod glb;
 pub mod json_merge;
 pub mod meshopt_decode;
@@ -38,9 +42,13 @@ pub mod write;
 
 pub use document::{read, read_bytes, Document, ReadOptions};
 pub use error::{Error, ErrorKind, Result};
+pub use files::{fallback_path, output_files, referenced_files};
 pub use meshopt_encode::Compression;
 pub use primitive::{
-    replace_primitive, replace_primitive_owned, Attribute, PrimitiveData, PrimitiveSize, Values,
+    replace_primitive, replace_primitive_owned, semantic, Attribute, MorphDeltas, PrimitiveData,
+    PrimitiveSize, Values,
 };
 pub use quantize::{quantize, Quantization};
-pub use write::{encode, fallback_path, to_glb_bytes, write, Files, OutputFile, WriteOptions};
+pub use write::{
+    encode, to_glb_bytes, write, write_files_atomically, Files, OutputFile, WriteOptions,
+};

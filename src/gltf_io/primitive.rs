@@ -3,8 +3,8 @@
 //! one back as new accessors.
 //!
 //! It deliberately keeps everything about the primitive it does not understand (material,
-//! extensions, extras) and refuses Draco-compressed primitives rather than reading their
-//! placeholder accessors, which hold zeros.
+//! extensions, extras). A Draco-compressed primitive is decoded from its stream
+//! ([`super::draco_decode`]), never from its placeholder accessors, which hold no data.
 
 use gltf_json::accessor::{ComponentType, GenericComponentType, Type};
 use gltf_json::mesh::Mode;
@@ -15,6 +15,7 @@ use super::accessor::{self, component_size, vector_type};
 use super::bounds;
 use super::buffer_data::BufferData;
 use super::document::{Document, ReadOptions};
+use super::draco_decode;
 use super::error::{Error, Result};
 use super::validate::is_triangle_mode;
 
@@ -62,6 +63,80 @@ impl Attribute {
     pub fn count(&self) -> usize {
         self.values.len() / self.components.max(1)
     }
+
+    /// A new float attribute, written as 32-bit floats.
+    pub fn float(name: &str, components: usize, values: Vec<f32>) -> Attribute {
+        Attribute {
+            name: name.to_string(),
+            components,
+            values: Values::Float(values),
+            component_type: ComponentType::F32,
+            normalized: false,
+        }
+    }
+
+    /// Its values as float 3-vectors, if that is what it holds.
+    pub fn vec3(&self) -> Option<&[f32]> {
+        match &self.values {
+            Values::Float(v) if self.components == 3 => Some(v),
+            _ => None,
+        }
+    }
+}
+
+/// The glTF attribute names the tool gives a meaning to, and the rules that pair attributes:
+/// the only place outside reading and writing that spells them.
+pub mod semantic {
+    /// Vertex positions.
+    pub const POSITION: &str = "POSITION";
+    /// Vertex normals.
+    pub const NORMAL: &str = "NORMAL";
+    /// Vertex tangents (xyz and the handedness w).
+    pub const TANGENT: &str = "TANGENT";
+
+    /// The texture coordinate set `set`.
+    pub fn texcoord(set: u32) -> String {
+        format!("TEXCOORD_{set}")
+    }
+
+    /// The skin weights paired with the joint indices `joints` (`JOINTS_n` → `WEIGHTS_n`).
+    pub fn weights_of(joints: &str) -> Option<String> {
+        joints
+            .strip_prefix("JOINTS_")
+            .map(|set| format!("WEIGHTS_{set}"))
+    }
+
+    /// The joint indices paired with the skin weights `weights` (`WEIGHTS_n` → `JOINTS_n`).
+    pub fn joints_of(weights: &str) -> Option<String> {
+        weights
+            .strip_prefix("WEIGHTS_")
+            .map(|set| format!("JOINTS_{set}"))
+    }
+}
+
+/// One morph target's displacements of the core arrays.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct MorphDeltas<'a> {
+    /// Position deltas, 3 per vertex.
+    pub positions: Option<&'a [f32]>,
+    /// Normal deltas, 3 per vertex.
+    pub normals: Option<&'a [f32]>,
+}
+
+impl<'a> MorphDeltas<'a> {
+    /// The position and normal deltas of morph target `target` (other attributes ignored).
+    pub fn of(target: &'a [Attribute]) -> Self {
+        let find = |name: &str| {
+            target
+                .iter()
+                .find(|a| a.name == name)
+                .and_then(Attribute::vec3)
+        };
+        MorphDeltas {
+            positions: find(semantic::POSITION),
+            normals: find(semantic::NORMAL),
+        }
+    }
 }
 
 /// A triangle primitive as arrays: attributes, a triangle list, morph targets.
@@ -83,7 +158,67 @@ impl PrimitiveData {
 
     /// Number of vertices (of POSITION).
     pub fn vertex_count(&self) -> usize {
-        self.attribute("POSITION").map_or(0, Attribute::count)
+        self.attribute(semantic::POSITION)
+            .map_or(0, Attribute::count)
+    }
+
+    /// The positions, 3 floats per vertex, all finite; the error names the primitive at JSON
+    /// path `at`.
+    pub fn positions(&self, at: &str) -> Result<&[f32]> {
+        let positions = match self.attribute(semantic::POSITION) {
+            Some(a) if a.components == 3 => match &a.values {
+                Values::Float(v) => v,
+                Values::Uint(_) => unreachable!("positions are decoded as floats"),
+            },
+            Some(a) => {
+                return Err(Error::invalid(
+                    format!("{at}.attributes.POSITION"),
+                    format!("has {} components (expected 3)", a.components),
+                ))
+            }
+            None => {
+                return Err(Error::invalid(
+                    format!("{at}.attributes"),
+                    "has no POSITION (expected a triangle primitive with positions)",
+                ))
+            }
+        };
+        if let Some(i) = positions.iter().position(|x| !x.is_finite()) {
+            return Err(Error::invalid(
+                format!("{at}.attributes.POSITION"),
+                format!("vertex {} is not finite (expected finite numbers)", i / 3),
+            ));
+        }
+        Ok(positions)
+    }
+
+    /// The normals, 3 floats per vertex, if the primitive has float normals.
+    pub fn normals(&self) -> Option<&[f32]> {
+        self.attribute(semantic::NORMAL).and_then(Attribute::vec3)
+    }
+
+    /// The tangents, if the primitive has them.
+    pub fn tangents(&self) -> Option<&Attribute> {
+        self.attribute(semantic::TANGENT)
+    }
+
+    /// The skin weights paired with the joint indices `joints`, when the pair is what skinning
+    /// reads (4 integer joints, 4 float weights, one each per vertex).
+    pub fn skin_weights(&self, joints: &Attribute) -> Option<&Attribute> {
+        let weights = self.attribute(&semantic::weights_of(&joints.name)?)?;
+        let paired = matches!(joints.values, Values::Uint(_))
+            && matches!(weights.values, Values::Float(_))
+            && joints.components == 4
+            && weights.values.len() == joints.values.len();
+        paired.then_some(weights)
+    }
+
+    /// Whether `weights` is paired with joint indices (see [`PrimitiveData::skin_weights`]
+    /// for the rule: checked from the joints' side).
+    pub fn is_paired_weights(&self, weights: &str) -> bool {
+        semantic::joints_of(weights)
+            .and_then(|j| self.attribute(&j))
+            .is_some_and(|j| matches!(j.values, Values::Uint(_)) && j.components == 4)
     }
 }
 
@@ -115,6 +250,28 @@ impl Document {
                 .get("primitives")?
                 .get(prim)
         })
+    }
+
+    /// The `extras` of mesh `mesh` as plain JSON, if any.
+    pub fn mesh_extras(&self, mesh: usize) -> Option<Value> {
+        self.raw.pointer(&format!("/meshes/{mesh}/extras")).cloned()
+    }
+
+    /// The `extras` of primitive `prim` of mesh `mesh` as plain JSON, if any.
+    pub fn primitive_extras(&self, mesh: usize, prim: usize) -> Option<Value> {
+        self.raw
+            .pointer(&format!("/meshes/{mesh}/primitives/{prim}/extras"))
+            .cloned()
+    }
+
+    /// The texture coordinate set of the normal texture of primitive `prim` of mesh `mesh`'s
+    /// material, if it has one.
+    pub fn normal_texture_set(&self, mesh: usize, prim: usize) -> Option<u32> {
+        self.root.meshes[mesh].primitives[prim]
+            .material
+            .and_then(|m| self.root.materials.get(m.value()))
+            .and_then(|m| m.normal_texture.as_ref())
+            .map(|t| t.tex_coord)
     }
 
     /// Every (mesh, primitive) whose mode is a triangle list, strip or fan, in file order.
@@ -178,32 +335,67 @@ impl Document {
         let json = self
             .primitive_json(mesh, prim)
             .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
-        if let Some(ext) = json.get("extensions").and_then(Value::as_object) {
-            if let Some(name) = ext
-                .keys()
-                .find(|k| k.as_str() == "KHR_draco_mesh_compression")
-            {
-                return Err(Error::unsupported(
-                    format!("{at}.extensions.{name}"),
-                    "draco-compressed geometry cannot be decoded by this tool (expected uncompressed or meshopt-compressed data)",
-                ));
-            }
-        }
         let max =
             ReadOptions::DEFAULT_MAX_BYTES.max(self.buffers.iter().map(|b| b.len() as u64).sum());
-        let attributes = read_attributes(
-            self,
-            json.get("attributes"),
-            &format!("{at}.attributes"),
-            false,
-            max,
-        )?;
-        let vertices = attributes.first().map_or(0, Attribute::count);
-        let list: Vec<u32> = match json.get("indices") {
-            Some(i) => accessor::read(self, index_of(i, &format!("{at}.indices"))?, max)?.to_u32(),
-            None => (0..vertices as u32).collect(),
+        let draco = json.pointer(&format!("/extensions/{}", draco_decode::EXTENSION));
+        let (attributes, list) = match draco {
+            Some(ext) => {
+                let decoded = draco_decode::read(self, json, ext, &at)?;
+                let mut attributes = Vec::with_capacity(decoded.attributes.len());
+                for slot in decoded.attributes {
+                    let a = match slot {
+                        draco_decode::Slot::Decoded(a) => a,
+                        draco_decode::Slot::Accessor(name) => {
+                            let one = json.get("attributes").and_then(|a| a.get(&name));
+                            let single = one.map(|i| json!({ name.clone(): i }));
+                            let mut read = read_attributes(
+                                self,
+                                single.as_ref(),
+                                &format!("{at}.attributes"),
+                                false,
+                                max,
+                            )?;
+                            let a = read.pop().expect("one attribute read");
+                            if a.count() != decoded.points {
+                                return Err(Error::invalid(
+                                    format!("{at}.attributes.{name}"),
+                                    format!(
+                                        "has {} elements, the Draco stream {} points (expected one per point)",
+                                        a.count(),
+                                        decoded.points
+                                    ),
+                                ));
+                            }
+                            a
+                        }
+                    };
+                    attributes.push(a);
+                }
+                (attributes, decoded.indices)
+            }
+            None => {
+                let attributes = read_attributes(
+                    self,
+                    json.get("attributes"),
+                    &format!("{at}.attributes"),
+                    false,
+                    max,
+                )?;
+                let vertices = attributes.first().map_or(0, Attribute::count);
+                let list: Vec<u32> = match json.get("indices") {
+                    Some(i) => {
+                        accessor::read(self, index_of(i, &format!("{at}.indices"))?, max)?.to_u32()
+                    }
+                    None => (0..vertices as u32).collect(),
+                };
+                (attributes, list)
+            }
         };
-        let mode = json.get("mode").and_then(Value::as_u64).unwrap_or(4);
+        // A Draco stream holds its faces as a triangle list whatever the mode says.
+        let mode = match draco {
+            Some(_) => 4,
+            None => json.get("mode").and_then(Value::as_u64).unwrap_or(4),
+        };
         let indices = match mode {
             4 => list[..list.len() - list.len() % 3].to_vec(),
             5 => (0..list.len().saturating_sub(2))
@@ -308,6 +500,13 @@ pub fn replace_primitive_owned(
         .cloned()
         .ok_or_else(|| Error::invalid(&at, "does not exist"))?;
     collect_accessor_refs(&json, &mut doc.replaced_accessors);
+    // The new data is written uncompressed: the Draco stream no longer describes it.
+    if let Some(ext) = json.get_mut("extensions").and_then(Value::as_object_mut) {
+        ext.remove(draco_decode::EXTENSION);
+        if ext.is_empty() {
+            json.as_object_mut().map(|o| o.remove("extensions"));
+        }
+    }
     let vertices = data.vertex_count();
     let index_bounds = bounds::uint_bounds(&data.indices);
     if let Some((_, bad)) = index_bounds.filter(|(_, hi)| *hi as usize >= vertices) {

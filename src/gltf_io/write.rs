@@ -15,8 +15,9 @@ use serde_json::{json, Map, Value};
 use super::buffer_data::Pieces;
 use super::document::Document;
 use super::error::{Error, Result};
+use super::files::{bin_path, fallback_path};
 use super::meshopt_encode::{self, Compression};
-use super::{dequantize_nodes, glb, json_merge, meshopt_decode, uri};
+use super::{dequantize_nodes, draco_decode, glb, json_merge, meshopt_decode, uri};
 
 /// How to write.
 #[derive(Debug, Clone, Default)]
@@ -46,11 +47,6 @@ impl WriteOptions {
         self.compression = compression;
         self
     }
-}
-
-/// The file beside `path` that holds the uncompressed fallback of a compressed output.
-pub fn fallback_path(path: &Path) -> PathBuf {
-    path.with_extension("fallback.bin")
 }
 
 /// One file of an output: its path and its bytes, held as the pieces they are made of (most of
@@ -101,16 +97,34 @@ impl OutputFile {
     }
 }
 
+/// Writes every file of one output as a set: each to a temporary file beside its path first,
+/// and only when all of them are on disk, renames them into place in order (a file before the
+/// file that refers to it). On an error while writing (a full disk), the temporary files are
+/// removed and the previous files are all kept, so that a `.gltf` never ends up beside a `.bin`
+/// of another run.
+///
+/// The renames themselves are not one step: should one fail (it replaces a name in the same
+/// folder, so only a concurrent change of the folder could make it), the files renamed before
+/// it are already new.
+pub fn write_files_atomically(files: &[OutputFile]) -> Result<()> {
+    let staged = files
+        .iter()
+        .map(|f| stage(&f.path, f.bytes.iter()))
+        .collect::<Result<Vec<_>>>()?;
+    for (tmp, file) in staged.into_iter().zip(files) {
+        tmp.persist(&file.path)
+            .map_err(|e| Error::io(file.path.display(), e.error))?;
+    }
+    Ok(())
+}
+
 /// The files of one output, in the order they are to be written (a file before the file that
 /// refers to it).
 pub type Files = Vec<OutputFile>;
 
 /// Writes `doc` to `path` (`.glb`, or `.gltf` + `<stem>.bin`).
 pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
-    for file in encode(doc, path, opts)? {
-        file.write_atomically()?;
-    }
-    Ok(())
+    write_files_atomically(&encode(doc, path, opts)?)
 }
 
 /// The files [`write()`] would create for `path`, with their bytes, in the order it writes them
@@ -133,7 +147,7 @@ pub fn encode(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<Files>
             ))
         }
     };
-    let bin_path = (!as_glb).then(|| path.with_extension("bin"));
+    let bin_path = (!as_glb).then(|| bin_path(path));
     let fallback = opts
         .compression
         .filter(|c| c.fallback)
@@ -255,6 +269,18 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
 /// Writes the concatenation of `pieces` to a temporary file in `path`'s folder, flushes it to
 /// disk, then renames it over `path`: a reader sees the old file or the whole new one.
 fn write_pieces_atomically<'a>(path: &Path, pieces: impl Iterator<Item = &'a [u8]>) -> Result<()> {
+    let tmp = stage(path, pieces)?;
+    tmp.persist(path)
+        .map_err(|e| Error::io(path.display(), e.error))?;
+    Ok(())
+}
+
+/// Writes the concatenation of `pieces` to a new temporary file in `path`'s folder and flushes
+/// it to disk; dropping the result removes it.
+fn stage<'a>(
+    path: &Path,
+    pieces: impl Iterator<Item = &'a [u8]>,
+) -> Result<tempfile::NamedTempFile> {
     let shown = path.display().to_string();
     let mut builder = tempfile::Builder::new();
     builder.prefix(".g2tess-").suffix(".tmp");
@@ -286,8 +312,7 @@ fn write_pieces_atomically<'a>(path: &Path, pieces: impl Iterator<Item = &'a [u8
         .into_inner()
         .map_err(|e| Error::io(&shown, e.into_error()))?;
     tmp.as_file().sync_all().map_err(|e| Error::io(&shown, e))?;
-    tmp.persist(path).map_err(|e| Error::io(&shown, e.error))?;
-    Ok(())
+    Ok(tmp)
 }
 
 /// Bytes written between two requests to start writing back to disk.
@@ -715,12 +740,25 @@ fn fix_extension_lists(root: &mut Map<String, Value>) {
     if quantized {
         add_extension(root, "KHR_mesh_quantization", true);
     }
+    // Primitives decoded from Draco are written uncompressed; the others keep their stream.
+    let draco = root
+        .get("meshes")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .filter_map(|m| m.get("primitives").and_then(Value::as_array))
+        .flatten()
+        .any(|p| {
+            p.pointer(&format!("/extensions/{}", draco_decode::EXTENSION))
+                .is_some()
+        });
     for key in ["extensionsUsed", "extensionsRequired"] {
         if let Some(list) = root.get_mut(key).and_then(Value::as_array_mut) {
             list.retain(|e| {
                 let name = e.as_str().unwrap_or("");
                 !meshopt_decode::EXTENSIONS.contains(&name)
                     && (quantized || name != "KHR_mesh_quantization")
+                    && (draco || name != draco_decode::EXTENSION)
             });
             if list.is_empty() {
                 root.remove(key);

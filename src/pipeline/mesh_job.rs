@@ -16,7 +16,7 @@ use super::error::Error;
 use super::morph;
 use super::primitive_out::{self, Prepared};
 use super::report::{EdgeFigures, MeshReport, PrimitiveReport};
-use crate::gltf_io::{self, PrimitiveData, Values};
+use crate::gltf_io::{self, PrimitiveData};
 use crate::mesh::TriMesh;
 use crate::options::Options;
 use crate::sharpness::{AssetSharpness, EdgeParams, MeshContext, PrimitiveContext};
@@ -226,30 +226,7 @@ fn prepare(
 ) -> Result<Prepared, gltf_io::Error> {
     let at = format!("meshes[{mesh}].primitives[{}]", input.index);
     let data = &input.data;
-    let positions = match data.attribute("POSITION") {
-        Some(a) if a.components == 3 => match &a.values {
-            Values::Float(v) => v,
-            Values::Uint(_) => unreachable!("positions are decoded as floats"),
-        },
-        Some(a) => {
-            return Err(gltf_io::Error::invalid(
-                format!("{at}.attributes.POSITION"),
-                format!("has {} components (expected 3)", a.components),
-            ))
-        }
-        None => {
-            return Err(gltf_io::Error::invalid(
-                format!("{at}.attributes"),
-                "has no POSITION (expected a triangle primitive with positions)",
-            ))
-        }
-    };
-    if let Some(i) = positions.iter().position(|x| !x.is_finite()) {
-        return Err(gltf_io::Error::invalid(
-            format!("{at}.attributes.POSITION"),
-            format!("vertex {} is not finite (expected finite numbers)", i / 3),
-        ));
-    }
+    let positions = data.positions(&at)?;
     let vertex_count = positions.len() / 3;
     let triangles: Vec<[u32; 3]> = data
         .indices
@@ -266,10 +243,7 @@ fn prepare(
         .chunks_exact(3)
         .map(|p| DVec3::new(p[0].into(), p[1].into(), p[2].into()))
         .collect();
-    let input_normals = data.attribute("NORMAL").and_then(|a| match &a.values {
-        Values::Float(v) if a.components == 3 => Some(v),
-        _ => None,
-    });
+    let input_normals = data.normals();
     match input_normals {
         Some(n) => {
             let mut repaired = 0;

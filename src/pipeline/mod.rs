@@ -19,7 +19,6 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use serde_json::Value;
 
 use crate::gltf_io::{self, Document, PrimitiveData, WriteOptions};
 use crate::options::Options;
@@ -34,13 +33,33 @@ pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<Fi
     let started = Instant::now();
     let (mut report, files) = encode_file(input, output, options)?;
     let write_start = Instant::now();
-    for file in &files {
-        file.write_atomically()
-            .map_err(|e| Error::gltf(output, e))?;
-    }
+    gltf_io::write_files_atomically(&files).map_err(|e| Error::gltf(output, e))?;
     report.times.write += write_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// Every file that processing `asset` under `options` reads: the asset, the buffer and image
+/// files it refers to (as [`gltf_io::referenced_files`] resolves them), and its sidecar (the
+/// one named by `--sidecar`, else the one beside it, listed whether or not it exists, since
+/// creating it changes the result). Skipping up-to-date outputs, watching, and refusing an
+/// output that would replace another asset's input all start from this list.
+///
+/// Never fails: an unreadable asset is listed alone, and processing it reports why.
+pub fn files_read(asset: &Path, options: &Options) -> Vec<std::path::PathBuf> {
+    let mut files = vec![asset.to_path_buf()];
+    files.extend(gltf_io::referenced_files(asset, options.allow_outside_uris));
+    files.push(match &options.sidecar {
+        Some(s) => s.clone(),
+        None => crate::sharpness::sidecar_path_for(asset),
+    });
+    files
+}
+
+/// Every file that [`process_file`] may write for `output` under `options` (the output, a
+/// `.gltf`'s `.bin`, a compressed output's fallback buffer), by name, before any is written.
+pub fn files_written(output: &Path, options: &Options) -> Vec<std::path::PathBuf> {
+    gltf_io::output_files(output, options.compression())
 }
 
 /// Does everything [`process_file`] does except writing: returns the files it would write
@@ -148,17 +167,14 @@ fn mesh_inputs(doc: &Document, asset: &Path) -> Result<Vec<MeshInput>, Error> {
             inputs.push(MeshInput {
                 mesh,
                 name: doc.root.meshes[mesh].name.clone(),
-                extras: raw_extras(doc, &["meshes"], mesh),
+                extras: doc.mesh_extras(mesh),
                 primitives: Vec::new(),
             });
         }
         let current = inputs.last_mut().expect("pushed above");
         current.primitives.push(mesh_job::PrimitiveInput {
             index: prim,
-            extras: doc
-                .raw
-                .pointer(&format!("/meshes/{mesh}/primitives/{prim}/extras"))
-                .cloned(),
+            extras: doc.primitive_extras(mesh, prim),
             needs_tangents: needs_tangents(doc, mesh, prim, &data),
             data,
         });
@@ -217,23 +233,13 @@ pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<Str
         .collect())
 }
 
-/// The `extras` of `collection[index]` as plain JSON, if any.
-fn raw_extras(doc: &Document, collection: &[&str], index: usize) -> Option<Value> {
-    let pointer = format!("/{}/{index}/extras", collection.join("/"));
-    doc.raw.pointer(&pointer).cloned()
-}
-
 /// Tangents are regenerated when the input had them, or when the primitive's material has a
 /// normal texture (a renderer would otherwise derive them per pixel from screen derivatives,
 /// which no longer match a bake against the low-poly mesh).
 fn needs_tangents(doc: &Document, mesh: usize, prim: usize, data: &PrimitiveData) -> Option<u32> {
-    let normal_texture = doc.root.meshes[mesh].primitives[prim]
-        .material
-        .and_then(|m| doc.root.materials.get(m.value()))
-        .and_then(|m| m.normal_texture.as_ref());
-    match normal_texture {
-        Some(t) => Some(t.tex_coord),
-        None if data.attribute("TANGENT").is_some() => Some(0),
+    match doc.normal_texture_set(mesh, prim) {
+        Some(set) => Some(set),
+        None if data.tangents().is_some() => Some(0),
         None => None,
     }
 }

@@ -11,7 +11,7 @@ use std::ops::Range;
 use glam::DVec3;
 
 use super::primitive_out::Prepared;
-use crate::gltf_io::Values;
+use crate::gltf_io::MorphDeltas;
 use crate::mesh::TriMesh;
 use crate::optimize::remap_stream;
 use crate::options::Options;
@@ -77,22 +77,20 @@ fn displaced(mesh: &TriMesh, prepared: &[Prepared], t: usize) -> TriMesh {
             continue;
         };
         let offset = p.vertex_offset as usize;
-        for a in target {
-            let (Values::Float(d), 3) = (&a.values, a.components) else {
-                continue;
-            };
-            let slots = moved.positions.len().min(offset + d.len() / 3);
-            for (v, c) in (offset..slots).zip(d.chunks_exact(3)) {
-                let delta = DVec3::new(c[0].into(), c[1].into(), c[2].into());
-                match a.name.as_str() {
-                    "POSITION" => moved.positions[v] += delta,
-                    "NORMAL" => {
-                        let n = (mesh.normals[v] + delta).normalize_or_zero();
-                        if n != DVec3::ZERO {
-                            moved.normals[v] = n;
-                        }
-                    }
-                    _ => {}
+        let deltas = MorphDeltas::of(target);
+        let len = moved.positions.len();
+        let slots = |d: &[f32]| len.min(offset + d.len() / 3);
+        let delta = |c: &[f32]| DVec3::new(c[0].into(), c[1].into(), c[2].into());
+        if let Some(d) = deltas.positions {
+            for (v, c) in (offset..slots(d)).zip(d.chunks_exact(3)) {
+                moved.positions[v] += delta(c);
+            }
+        }
+        if let Some(d) = deltas.normals {
+            for (v, c) in (offset..slots(d)).zip(d.chunks_exact(3)) {
+                let n = (mesh.normals[v] + delta(c)).normalize_or_zero();
+                if n != DVec3::ZERO {
+                    moved.normals[v] = n;
                 }
             }
         }

@@ -10,11 +10,11 @@ use rayon::prelude::*;
 
 use super::morph::TargetSurface;
 use crate::attributes::{self, Carry, FloatAttribute, Skin, SourceTriangles};
+use crate::gltf_io::semantic::{self, NORMAL, POSITION, TANGENT};
 use crate::gltf_io::{Attribute, PrimitiveData, Values};
 use crate::normals::GeneratedNormals;
 use crate::tangents;
 use crate::tessellate::DenseMesh;
-use gltf_json::accessor::ComponentType;
 
 /// A primitive ready for the surface: its arrays (vertices split where generated normals
 /// required it), its unit normals, and its place in the joined mesh.
@@ -48,13 +48,10 @@ impl Prepared {
         triangles: Vec<[u32; 3]>,
         needs_tangents: Option<u32>,
     ) -> Self {
-        let exact_normals = data.attribute("NORMAL").and_then(|a| match &a.values {
-            Values::Float(v) if a.components == 3 => Some(
-                v.chunks_exact(3)
-                    .map(|c| [c[0], c[1], c[2]])
-                    .collect::<Vec<_>>(),
-            ),
-            _ => None,
+        let exact_normals = data.normals().map(|v| {
+            v.chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect::<Vec<_>>()
         });
         let source_vertex_count = positions.len();
         Prepared {
@@ -130,13 +127,7 @@ fn is_id_like(name: &str) -> bool {
 }
 
 fn float_attribute(name: &str, components: usize, values: Vec<f32>) -> Attribute {
-    Attribute {
-        name: name.to_string(),
-        components,
-        values: Values::Float(values),
-        component_type: ComponentType::F32,
-        normalized: false,
-    }
+    Attribute::float(name, components, values)
 }
 
 /// The replacement primitive for `prep`, from its dense mesh `dense` (whose sources refer to
@@ -163,32 +154,29 @@ pub fn build(
     let mut skin_sets: Vec<(String, String)> = Vec::new();
     for a in &prep.data.attributes {
         match a.name.as_str() {
-            "POSITION" | "NORMAL" => {} // moved in last
-            "TANGENT" => {}             // regenerated below
-            name if name.starts_with("JOINTS_") => {
-                let set = &name["JOINTS_".len()..];
-                let weights = format!("WEIGHTS_{set}");
-                if let (Values::Uint(j), Some(w)) = (&a.values, prep.data.attribute(&weights)) {
-                    if let Values::Float(w) = &w.values {
-                        if a.components == 4 && w.len() == j.len() {
-                            skin.joints.push(
-                                j.chunks_exact(4)
-                                    .map(|c| [c[0], c[1], c[2], c[3]])
-                                    .collect(),
-                            );
-                            skin.weights.push(
-                                w.chunks_exact(4)
-                                    .map(|c| [c[0], c[1], c[2], c[3]])
-                                    .collect(),
-                            );
-                            skin_sets.push((name.to_string(), weights));
-                            continue;
-                        }
+            POSITION | NORMAL => {} // moved in last
+            TANGENT => {}           // regenerated below
+            name if semantic::weights_of(name).is_some() => {
+                let paired = prep.data.skin_weights(a).map(|w| (&a.values, w));
+                if let Some((Values::Uint(j), w)) = paired {
+                    if let Values::Float(wv) = &w.values {
+                        skin.joints.push(
+                            j.chunks_exact(4)
+                                .map(|c| [c[0], c[1], c[2], c[3]])
+                                .collect(),
+                        );
+                        skin.weights.push(
+                            wv.chunks_exact(4)
+                                .map(|c| [c[0], c[1], c[2], c[3]])
+                                .collect(),
+                        );
+                        skin_sets.push((name.to_string(), w.name.clone()));
+                        continue;
                     }
                 }
                 attributes.push(carry_one(a, tris, &dense));
             }
-            name if name.starts_with("WEIGHTS_") && skin_sets_has(prep, name) => {}
+            name if prep.data.is_paired_weights(name) => {}
             _ => attributes.push(carry_one(a, tris, &dense)),
         }
     }
@@ -211,7 +199,7 @@ pub fn build(
         }
     }
     let uv_of = |set: u32| -> Option<Vec<[f32; 2]>> {
-        let name = format!("TEXCOORD_{set}");
+        let name = semantic::texcoord(set);
         attributes
             .iter()
             .find(|a| a.name == name)
@@ -229,7 +217,7 @@ pub fn build(
     let base_tangents = base_tangents.or_else(|| {
         // Tangents without the texture coordinates to regenerate them: carry them and make
         // them perpendicular to the new normals again.
-        let input = prep.data.attribute("TANGENT")?;
+        let input = prep.data.tangents()?;
         let Values::Float(v) = carry_one(input, tris, &dense).values else {
             return None;
         };
@@ -242,7 +230,7 @@ pub fn build(
     });
     if let Some(t) = &base_tangents {
         attributes.push(float_attribute(
-            "TANGENT",
+            TANGENT,
             4,
             t.iter().flatten().copied().collect(),
         ));
@@ -271,16 +259,16 @@ pub fn build(
         indices,
         ..
     } = dense;
-    attributes.push(float_attribute("POSITION", 3, positions.into_flattened()));
-    attributes.push(float_attribute("NORMAL", 3, normals.into_flattened()));
+    attributes.push(float_attribute(POSITION, 3, positions.into_flattened()));
+    attributes.push(float_attribute(NORMAL, 3, normals.into_flattened()));
 
     // Attributes keep the input's order (tools and diffs read it); new ones follow.
     let rank = |name: &str| -> usize {
         let input = &prep.data.attributes;
         match input.iter().position(|a| a.name == name) {
             Some(i) => 2 * i,
-            None if name == "NORMAL" => {
-                2 * input.iter().position(|a| a.name == "POSITION").unwrap_or(0) + 1
+            None if name == NORMAL => {
+                2 * input.iter().position(|a| a.name == POSITION).unwrap_or(0) + 1
             }
             None => usize::MAX,
         }
@@ -299,11 +287,6 @@ fn reorthogonalize(t: [f32; 4], n: [f32; 3]) -> [f32; 4] {
     let v = glam::Vec3::new(t[0], t[1], t[2]);
     let v = (v - n * n.dot(v)).normalize_or(n.any_orthonormal_vector());
     [v.x, v.y, v.z, if t[3] < 0.0 { -1.0 } else { 1.0 }]
-}
-
-fn skin_sets_has(prep: &Prepared, weights_name: &str) -> bool {
-    let joints = format!("JOINTS_{}", &weights_name["WEIGHTS_".len()..]);
-    matches!(prep.data.attribute(&joints), Some(a) if matches!(a.values, Values::Uint(_)) && a.components == 4)
 }
 
 /// Carries one attribute by the rule its name and type call for: integers and ID-like floats
@@ -386,17 +369,17 @@ fn target_attributes(
     let mut out = Vec::with_capacity(input.len());
     for a in input {
         match a.name.as_str() {
-            "POSITION" => out.push(float_attribute(
-                "POSITION",
+            POSITION => out.push(float_attribute(
+                POSITION,
                 3,
                 delta(&surface.positions, &dense.positions),
             )),
-            "NORMAL" => out.push(float_attribute(
-                "NORMAL",
+            NORMAL => out.push(float_attribute(
+                NORMAL,
                 3,
                 delta(&surface.normals, base_normals),
             )),
-            "TANGENT" => {
+            TANGENT => {
                 if let (Some(uv), Some(base)) = (uvs, base_tangents) {
                     let moved = tangents::generate(
                         &surface.positions,
@@ -409,7 +392,7 @@ fn target_attributes(
                         .zip(base)
                         .flat_map(|(m, b)| [m[0] - b[0], m[1] - b[1], m[2] - b[2]])
                         .collect();
-                    out.push(float_attribute("TANGENT", 3, d));
+                    out.push(float_attribute(TANGENT, 3, d));
                 }
             }
             _ => out.push(carry_one(a, tris, dense)),
