@@ -141,7 +141,7 @@ fn within_crease_sums(corners: impl Iterator<Item = (DVec3, f64)>, cos_crease: f
         .iter()
         .map(|&(n, w)| (n.to_array().map(f64::to_bits), n, w))
         .collect();
-    distinct.sort_unstable_by(|a, b| a.0.cmp(&b.0));
+    distinct.sort_unstable_by_key(|a| a.0);
     distinct.dedup_by(|b, a| {
         let same = a.0 == b.0;
         if same {

@@ -53,7 +53,8 @@ pub struct Args {
     #[arg(long, value_enum, help_heading = "Surface")]
     pub scheme: Option<SchemeArg>,
 
-    /// Coons shape parameter λ of seed 002, 0.05 to 0.95 [default: 0.5]
+    /// Coons shape parameter λ (Szilvási-Nagy and Szabó's Coons-type blending), 0.05 to 0.95
+    /// [default: 0.5]
     #[arg(long, value_name = "L", help_heading = "Surface")]
     pub coons_lambda: Option<f64>,
 

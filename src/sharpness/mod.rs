@@ -59,9 +59,8 @@ use crate::topology::{EdgeKind, Topology};
 use entries::at;
 use sidecar::MeshKey;
 
-/// The largest blend width: sqrt(2)/4, a quarter of the reference triangle's side, where the
-/// blending regions of a triangle's three edges meet.
-pub const H_MAX: f64 = std::f64::consts::SQRT_2 / 4.0;
+/// The largest blend width, √2/4: the surface's one definition, re-exported.
+pub use crate::surface::H_MAX;
 
 /// `from`/`to` positions match a welded vertex within this fraction of the mesh's bounding-box
 /// diagonal: loose enough for float round trips through other tools, far below any edge length.
@@ -161,7 +160,8 @@ impl AssetSharpness {
         mesh_names: &[Option<&str>],
         defaults: Defaults,
     ) -> Result<Self, SharpnessError> {
-        entries::check_h(defaults.h).map_err(|p| at(&Location::Options, p))?;
+        let mut defaults = defaults;
+        defaults.h = entries::check_h(defaults.h).map_err(|p| at(&Location::Options, p))?;
         entries::check_crease_angle(defaults.crease_angle)
             .map_err(|p| at(&Location::Options, p))?;
         let mut section_of_mesh: HashMap<usize, usize> = HashMap::new();
