@@ -117,12 +117,26 @@ fn normals_facing_away_orient_the_surface_with_a_warning() {
 }
 
 #[test]
-fn zero_normal_is_an_error_at_its_element() {
+fn zero_normal_is_repaired_with_a_warning() {
     let (p, i) = tetrahedron();
     let mut n = vec![[0.0, 0.0, 1.0]; 4];
     n[2] = [0.0; 3];
+    warned(
+        &process(&p, Some(&n), &i).unwrap(),
+        "meshes[0].primitives[0].attributes.NORMAL (accessors[1]): 1 zero-length normals (first: vertex 2) replaced by the angle-weighted normal of their faces",
+    );
+}
+
+#[test]
+fn non_finite_normal_is_an_error_at_its_element() {
+    let (p, i) = tetrahedron();
+    let mut n = vec![[0.0, 0.0, 1.0]; 4];
+    n[2] = [0.0, f32::NAN, 1.0];
     let e = process(&p, Some(&n), &i).unwrap_err();
-    assert!(e.contains("meshes[0].primitives[0].attributes.NORMAL: element 2 has length 0.0000 (expected a unit vector)"), "{e}");
+    assert!(
+        e.contains("accessors[1]: element 2 holds NaN (expected finite numbers)"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -202,11 +216,55 @@ fn inconsistent_winding_is_smoothed_with_a_warning() {
 }
 
 #[test]
-fn open_boundary_is_reported() {
+fn open_boundary_is_reported_once_and_not_as_an_ignored_h() {
     let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let w = process(&p, None, &[0, 1, 2]).unwrap();
+    warned(&w, "3 open boundary edges");
+    // The default h covers boundary edges without naming them: nothing to warn about.
+    assert!(!w.iter().any(|w| w.contains("asked for")), "{w:#?}");
+}
+
+/// A book of 2 000 distinct triangles on one edge: one non-manifold edge, no bow-tie (all pages
+/// meet along the spine), and no duplicates.
+#[test]
+fn book_of_pages_on_one_edge_is_one_non_manifold_edge() {
+    let mut p = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+    let mut i = Vec::new();
+    for k in 0..2000u32 {
+        let a = k as f32 * std::f32::consts::TAU / 2000.0;
+        p.push([a.cos(), a.sin(), 0.5]);
+        i.extend([0, 1, k + 2]);
+    }
+    let w = process(&p, None, &i).unwrap();
     warned(
-        &process(&p, None, &[0, 1, 2]).unwrap(),
-        "3 open boundary edges",
+        &w,
+        "1 non-manifold edges (three or more triangles) (first: ",
+    );
+    assert!(
+        !w.iter()
+            .any(|w| w.contains("bow-tie") || w.contains("duplicate")),
+        "{w:#?}"
+    );
+}
+
+/// 2 000 copies of one triangle plus a second fan touching it at one vertex only: 1 999
+/// duplicates and one bow-tie vertex (the copies form one fan, the other triangle another).
+#[test]
+fn copies_of_a_triangle_and_a_second_fan_give_exact_counts() {
+    let p = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [-1.0, -1.0, 0.0],
+    ];
+    let mut i = [0, 1, 2].repeat(2000);
+    i.extend([0, 3, 4]);
+    let w = process(&p, None, &i).unwrap();
+    warned(&w, "1999 duplicate triangles (first: 1, 2, 3)");
+    warned(
+        &w,
+        "1 bow-tie vertices (triangle fans that touch only at the vertex) (first: 0)",
     );
 }
 

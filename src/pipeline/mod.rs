@@ -160,6 +160,13 @@ fn mesh_inputs(doc: &Document, asset: &Path) -> Result<Vec<MeshInput>, Error> {
                 .pointer(&format!("/meshes/{mesh}/primitives/{prim}/extras"))
                 .cloned(),
             needs_tangents: needs_tangents(doc, mesh, prim, &data),
+            normal_accessor: doc
+                .raw
+                .pointer(&format!(
+                    "/meshes/{mesh}/primitives/{prim}/attributes/NORMAL"
+                ))
+                .and_then(serde_json::Value::as_u64)
+                .map(|a| a as usize),
             data,
         });
     }

@@ -105,7 +105,12 @@ pub struct PrimitiveContext<'a> {
 /// One h per welded edge (indexed by [`crate::topology::EdgeId`]), why, and what looked odd.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeParams {
+    /// The h each edge's sources ask for (what `--explain-h` shows), in range.
     pub h: Vec<f64>,
+    /// The h each edge is built with: `h` clamped to √2/4 on interior edges, 0 on boundary,
+    /// non-manifold and degenerate ones. Decided once here; the surfaces, the tessellator's
+    /// creases, the morph targets and the report all read it.
+    pub effective: Vec<f64>,
     pub sources: Vec<HSource>,
     pub warnings: Vec<SharpnessWarning>,
 }
