@@ -4,6 +4,7 @@
 
 mod corpus;
 mod hostile;
+mod support;
 
 use std::path::Path;
 
@@ -278,4 +279,64 @@ fn thousands_of_tiny_pieces_are_each_smoothed_with_a_warning() {
         i.extend([3 * k, 3 * k + 1, 3 * k + 2]);
     }
     warned(&process(&p, None, &i).unwrap(), "3000 disconnected pieces");
+}
+
+/// An 80-triangle sphere of radius 3.38e38 with tilted normals: the hybrid and Coons control
+/// points leave the f32 range (they wrote Infinity, which the validator rejects). Every scheme
+/// either writes only finite numbers or fails the file naming the primitive and attribute.
+#[test]
+fn a_surface_beyond_the_float_range_is_refused_never_written() {
+    let mesh = support::subdivide(&support::icosahedron());
+    let p: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|q| (*q * 3.38e38).as_vec3().to_array())
+        .collect();
+    let n: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|q| {
+            let tilt = glam::DVec3::new(q.x + 0.4 * q.y, q.y - 0.4 * q.x, q.z + 0.3);
+            tilt.normalize().as_vec3().to_array()
+        })
+        .collect();
+    let i: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    let dir = corpus::temp_dir();
+    let (json, bin) = hostile::mesh_gltf(&p, Some(&n), &i, "t.bin");
+    std::fs::write(dir.path().join("t.bin"), bin).unwrap();
+    let input = dir.path().join("t.gltf");
+    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let mut refused = Vec::new();
+    for scheme in ["g2", "pn", "hybrid", "coons"] {
+        let output = dir.path().join(format!("{scheme}.glb"));
+        let run = run_limited(
+            &[
+                input.as_os_str(),
+                "-o".as_ref(),
+                output.as_os_str(),
+                "--scheme".as_ref(),
+                scheme.as_ref(),
+            ],
+            None,
+        );
+        assert_eq!(verdict(&run), None, "{scheme}: {run:?}");
+        if run.code == Some(1) {
+            assert!(
+                run.stderr.contains(&format!(
+                    "meshes[0].primitives[0].attributes.POSITION: the {scheme} surface reaches inf"
+                )),
+                "{scheme}: {}",
+                run.stderr
+            );
+            assert!(!output.exists(), "{scheme}: wrote an output");
+            refused.push(scheme);
+        } else {
+            scan_non_finite(&output).unwrap_or_else(|e| panic!("{scheme}: {e}"));
+        }
+    }
+    // The case is only a test while some scheme still overflows here.
+    assert!(
+        !refused.is_empty(),
+        "no scheme overflowed: raise the radius"
+    );
 }

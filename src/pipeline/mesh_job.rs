@@ -210,10 +210,47 @@ pub fn smooth_mesh(
             cache: options.report_figures.then(|| optimize::cache_figures(&d)),
         });
         let data = primitive_out::build(prep, d, groups[k].start as u32, target);
+        refuse_non_finite(&data, input.mesh, input.primitives[k].index, options)
+            .map_err(|e| Error::gltf(asset, e))?;
         primitives.push((input.primitives[k].index, data));
     }
     report.times.attributes = attr_start.elapsed().as_secs_f64();
     Ok(MeshOutput { primitives, report })
+}
+
+/// No output value is ever non-finite: a surface that overflows f32 (coordinates near its
+/// largest value, where a scheme's control points leave the range) fails the file with the
+/// primitive and attribute named, instead of writing Infinity or NaN that the validator rejects.
+fn refuse_non_finite(
+    data: &PrimitiveData,
+    mesh: usize,
+    prim: usize,
+    options: &Options,
+) -> Result<(), gltf_io::Error> {
+    let at = format!("meshes[{mesh}].primitives[{prim}]");
+    let lists = data.attributes.iter().map(|a| (a, String::new())).chain(
+        data.targets
+            .iter()
+            .enumerate()
+            .flat_map(|(t, attrs)| attrs.iter().map(move |a| (a, format!("targets[{t}].")))),
+    );
+    for (a, target) in lists {
+        let Values::Float(v) = &a.values else {
+            continue;
+        };
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            return Err(gltf_io::Error::invalid(
+                format!("{at}.{target}attributes.{}", a.name),
+                format!(
+                    "the {} surface reaches {} at output vertex {} (expected finite 32-bit floats; the input's coordinates are too close to the largest float for this scheme: scale the mesh down)",
+                    options.scheme.name(),
+                    v[i],
+                    i / a.components.max(1)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Seconds since `clock` minus what earlier stages already took.
