@@ -189,6 +189,34 @@ pub struct Options {
     /// primitive ([`crate::pipeline::PrimitiveReport::cache`], a sequential pass over the index
     /// buffer). It changes the report, never the output. Default: `false`.
     pub report_figures: bool,
+    /// A flag the caller sets to stop the work early (the CLI's Ctrl-C and SIGTERM): polled
+    /// between stages of every mesh, it fails the file with [`crate::pipeline::Error::Cancelled`]
+    /// instead of finishing it. Default: none (never cancelled).
+    pub cancel: Cancel,
+}
+
+/// An optional stop flag; it never takes part in comparing options (two runs that differ only
+/// in how they can be stopped make the same output).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Cancel(Option<&'static std::sync::atomic::AtomicBool>);
+
+impl Cancel {
+    /// Cancelled once `flag` is set.
+    pub fn on(flag: &'static std::sync::atomic::AtomicBool) -> Self {
+        Cancel(Some(flag))
+    }
+
+    /// Whether the work should stop.
+    pub fn requested(&self) -> bool {
+        self.0
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+    }
+}
+
+impl PartialEq for Cancel {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl Default for Options {
@@ -211,6 +239,7 @@ impl Default for Options {
             compress: DEFAULT_COMPRESS,
             compress_fallback: DEFAULT_COMPRESS_FALLBACK,
             report_figures: false,
+            cancel: Cancel::default(),
         }
     }
 }

@@ -218,3 +218,46 @@ fn a_sidecar_level_past_64_is_refused() {
         );
     }
 }
+
+/// One SIGTERM stops the file in flight between its stages: exit status 130 and no output,
+/// where it used to finish the file (6.4 million output triangles here) first.
+#[test]
+fn sigterm_stops_the_file_in_flight() {
+    let dir = corpus::temp_dir();
+    // A fan of 100 000 triangles at level 8: about two seconds of work.
+    let n = 100_000u32;
+    let turn = |i: u32| std::f32::consts::TAU * i as f32 / n as f32;
+    let mut p = vec![[0.0f32, 0.0, 0.0]];
+    p.extend((0..n).map(|i| [turn(i).cos(), turn(i).sin(), 0.3 * (7.0 * turn(i)).sin()]));
+    let normals = vec![[0.0f32, 0.0, 1.0]; p.len()];
+    let idx: Vec<u32> = (0..n).flat_map(|i| [0, i + 1, (i + 1) % n + 1]).collect();
+    let (json, bin) = mesh_gltf(&p, Some(&normals), &idx, "t.bin");
+    std::fs::write(dir.path().join("t.bin"), bin).unwrap();
+    let input = dir.path().join("t.gltf");
+    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let output = dir.path().join("out.glb");
+    let child = corpus::g2tess()
+        .args([
+            input.as_os_str(),
+            "-o".as_ref(),
+            output.as_os_str(),
+            "--level".as_ref(),
+            "8".as_ref(),
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(700));
+    let killed = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(
+        !output.exists(),
+        "the file in flight was finished: {stderr}"
+    );
+}

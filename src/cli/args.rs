@@ -272,6 +272,8 @@ impl Layers {
         let mut opts = opts.overlay(&self.flags);
         opts.sidecar = self.sidecar.clone();
         opts.report_figures = self.report_figures;
+        // Ctrl-C and SIGTERM stop the file in flight between its stages, not after it.
+        opts.cancel = options::Cancel::on(super::interrupt::flag());
         opts.validate("command line")?;
         Ok(opts)
     }

@@ -141,6 +141,7 @@ pub fn smooth_mesh(
         name: input.name.clone(),
         ..MeshReport::default()
     };
+    stop_if_cancelled(options, asset)?;
     let clock = Instant::now();
     let Resolved {
         prepared,
@@ -150,6 +151,7 @@ pub fn smooth_mesh(
         params,
     } = resolve(input, sharpness, options, asset, &mut report.warnings)?;
     report.times.sharpness = lap(&clock, 0.0);
+    stop_if_cancelled(options, asset)?;
 
     let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &params.effective);
     report.warnings.extend(
@@ -163,6 +165,7 @@ pub fn smooth_mesh(
         EdgeFigures::count(&topo, &params.effective)
     };
     report.times.surface = lap(&clock, report.times.sharpness);
+    stop_if_cancelled(options, asset)?;
 
     let tess_start = Instant::now();
     let mut dense = tessellate(
@@ -177,6 +180,7 @@ pub fn smooth_mesh(
     // The surface holds about 1 kB per input triangle: free it before the attributes are
     // carried, when the dense mesh is at its largest.
     drop(surface);
+    stop_if_cancelled(options, asset)?;
 
     // The tessellator already emits cache-friendly bands with vertices in first-use order:
     // meshoptimizer's vertex cache pass made both figures worse on its output and took longer
@@ -249,6 +253,17 @@ fn refuse_non_finite(
                 ),
             ));
         }
+    }
+    Ok(())
+}
+
+/// [`Error::Cancelled`] once the caller's stop flag is set: polled between stages, so a stop
+/// waits at most for one stage of one mesh.
+pub(super) fn stop_if_cancelled(options: &Options, asset: &Path) -> Result<(), Error> {
+    if options.cancel.requested() {
+        return Err(Error::Cancelled {
+            file: asset.to_path_buf(),
+        });
     }
     Ok(())
 }
