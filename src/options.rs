@@ -22,6 +22,8 @@ pub const MAX_H: f64 = crate::surface::H_MAX;
 /// [`MAX_H`] as every message and document prints it, rounded up to four decimals: the printed
 /// bound is itself accepted (and clamped to √2/4), so a user who copies it is never refused.
 pub const MAX_H_SHOWN: f64 = 0.3536;
+// The printed bound is √2/4 rounded up, so it admits √2/4 and nothing a tenth of a digit more.
+const _: () = assert!(MAX_H < MAX_H_SHOWN && MAX_H_SHOWN - MAX_H < 1e-4);
 /// Default crease angle in degrees: edges whose faces meet more sharply get `h = 0`.
 pub const DEFAULT_CREASE_ANGLE: f64 = 60.0;
 /// Default blend profile.
@@ -408,7 +410,6 @@ mod tests {
             }
         }
         assert_eq!(H.max, 0.3536);
-        assert!(MAX_H < H.max && H.max - MAX_H < 1e-4);
         assert_eq!(clamp_h(0.3536), MAX_H);
         assert_eq!(clamp_h(0.2), 0.2);
         let o = Options {

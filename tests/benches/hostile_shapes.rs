@@ -11,7 +11,6 @@ use g2tess::pipeline::process_document;
 use std::path::Path;
 
 #[path = "../hostile/mod.rs"]
-#[allow(dead_code)]
 mod hostile;
 
 /// Positions and indices of `n` triangles of one kind.
