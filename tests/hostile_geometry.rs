@@ -10,7 +10,7 @@ use std::path::Path;
 
 use g2tess::gltf_io::{self, ReadOptions};
 use g2tess::options::Options;
-use hostile::{mesh_gltf, run_limited, scan_non_finite, tetrahedron, verdict};
+use hostile::{run_limited, scan_non_finite, tetrahedron, verdict};
 
 /// Writes the mesh as `t.gltf` + `t.bin` in a fresh folder, processes it in the library (for the
 /// report's warnings) and with the real binary (for the exit status and the output), and returns
@@ -21,10 +21,7 @@ fn process(
     indices: &[u32],
 ) -> Result<Vec<String>, String> {
     let dir = corpus::temp_dir();
-    let (json, bin) = mesh_gltf(positions, normals, indices, "t.bin");
-    std::fs::write(dir.path().join("t.bin"), bin).unwrap();
-    let input = dir.path().join("t.gltf");
-    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let input = hostile::write_mesh(dir.path(), positions, normals, indices);
 
     let output = dir.path().join("out.glb");
     let run = run_limited(
@@ -191,15 +188,18 @@ fn non_manifold_edge_is_left_sharp_with_a_warning() {
     warned(&w, "1 non-manifold edges");
 }
 
+/// Two triangles that touch only at vertex 0 (`[0, 1, 2]` and `[0, 3, 4]`).
+const BOW_TIE: [[f32; 3]; 5] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [1.0, 1.0, 0.0],
+    [-1.0, 0.0, 0.0],
+    [-1.0, -1.0, 0.0],
+];
+
 #[test]
 fn bow_tie_vertex_is_kept_with_a_warning() {
-    let p = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [-1.0, -1.0, 0.0],
-    ];
+    let p = BOW_TIE;
     warned(
         &process(&p, None, &[0, 1, 2, 0, 3, 4]).unwrap(),
         "1 bow-tie vertices",
@@ -252,13 +252,7 @@ fn book_of_pages_on_one_edge_is_one_non_manifold_edge() {
 /// duplicates and one bow-tie vertex (the copies form one fan, the other triangle another).
 #[test]
 fn copies_of_a_triangle_and_a_second_fan_give_exact_counts() {
-    let p = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [-1.0, -1.0, 0.0],
-    ];
+    let p = BOW_TIE;
     let mut i = [0, 1, 2].repeat(2000);
     i.extend([0, 3, 4]);
     let w = process(&p, None, &i).unwrap();
@@ -302,10 +296,7 @@ fn a_surface_beyond_the_float_range_is_refused_never_written() {
         .collect();
     let i: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
     let dir = corpus::temp_dir();
-    let (json, bin) = hostile::mesh_gltf(&p, Some(&n), &i, "t.bin");
-    std::fs::write(dir.path().join("t.bin"), bin).unwrap();
-    let input = dir.path().join("t.gltf");
-    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let input = hostile::write_mesh(dir.path(), &p, Some(&n), &i);
     let mut refused = Vec::new();
     for scheme in ["g2", "pn", "hybrid", "coons"] {
         let output = dir.path().join(format!("{scheme}.glb"));

@@ -231,10 +231,7 @@ fn sigterm_stops_the_file_in_flight() {
     p.extend((0..n).map(|i| [turn(i).cos(), turn(i).sin(), 0.3 * (7.0 * turn(i)).sin()]));
     let normals = vec![[0.0f32, 0.0, 1.0]; p.len()];
     let idx: Vec<u32> = (0..n).flat_map(|i| [0, i + 1, (i + 1) % n + 1]).collect();
-    let (json, bin) = mesh_gltf(&p, Some(&normals), &idx, "t.bin");
-    std::fs::write(dir.path().join("t.bin"), bin).unwrap();
-    let input = dir.path().join("t.gltf");
-    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let input = hostile::write_mesh(dir.path(), &p, Some(&normals), &idx);
     let output = dir.path().join("out.glb");
     let child = corpus::g2tess()
         .args([

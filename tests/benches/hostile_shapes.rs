@@ -47,11 +47,8 @@ fn bench(c: &mut Criterion) {
             for with_normals in [true, false] {
                 let (p, idx) = shape(kind, n);
                 let normals = vec![[0.0, 0.0, 1.0]; p.len()];
-                let (json, bin) =
-                    hostile::mesh_gltf(&p, with_normals.then_some(&normals[..]), &idx, "t.bin");
-                std::fs::write(dir.path().join("t.bin"), bin).unwrap();
-                let path = dir.path().join("t.gltf");
-                std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+                let normals = with_normals.then_some(&normals[..]);
+                let path = hostile::write_mesh(dir.path(), &p, normals, &idx);
                 let doc = gltf_io::read(&path, &ReadOptions::default()).unwrap();
                 let label = format!("{kind}{}", if with_normals { "" } else { ", no normals" });
                 g.throughput(Throughput::Elements(n as u64));
