@@ -15,8 +15,15 @@ pub const DEFAULT_LEVEL: u32 = 4;
 pub const MAX_LEVEL: u32 = 64;
 /// Default blend width `h`, in the paper's reference triangle (0.6 of the maximum).
 pub const DEFAULT_H: f64 = 0.212;
-/// Largest blend width: sqrt(2)/4, a quarter of the reference triangle's side.
-pub const MAX_H: f64 = std::f64::consts::SQRT_2 / 4.0;
+/// Largest blend width: √2/4, a quarter of the reference triangle's side (the surface's one
+/// definition, [`crate::surface::H_MAX`]). Values up to [`MAX_H_SHOWN`] are accepted and
+/// clamped to it.
+pub const MAX_H: f64 = crate::surface::H_MAX;
+/// [`MAX_H`] as every message and document prints it, rounded up to four decimals: the printed
+/// bound is itself accepted (and clamped to √2/4), so a user who copies it is never refused.
+pub const MAX_H_SHOWN: f64 = 0.3536;
+// The printed bound is √2/4 rounded up, so it admits √2/4 and nothing a tenth of a digit more.
+const _: () = assert!(MAX_H < MAX_H_SHOWN && MAX_H_SHOWN - MAX_H < 1e-4);
 /// Default crease angle in degrees: edges whose faces meet more sharply get `h = 0`.
 pub const DEFAULT_CREASE_ANGLE: f64 = 60.0;
 /// Default blend profile.
@@ -40,7 +47,8 @@ pub const DEFAULT_OVERWRITE_INPUT: bool = false;
 pub const DEFAULT_KEEP_HARD_EDGES: bool = false;
 /// Default: no overdraw ordering (it costs time and helps only some materials).
 pub const DEFAULT_OVERDRAW: bool = false;
-/// Default Coons shape parameter λ (seed 002), in [0.05, 0.95].
+/// Default Coons shape parameter λ (Szilvási-Nagy and Szabó's Coons-type blending), in
+/// [0.05, 0.95].
 pub const DEFAULT_COONS_LAMBDA: f64 = SchemeParams::DEFAULT_LAMBDA;
 /// Default: Coons uses the fixed λ rather than thin-plate fairing per triangle.
 pub const DEFAULT_COONS_FAIR: bool = false;
@@ -53,6 +61,95 @@ pub const DEFAULT_COMPRESS: bool = false;
 pub const DEFAULT_COMPRESS_FALLBACK: bool = false;
 
 pub use crate::surface::{Nets, Profile, Scheme};
+
+/// The range of a numeric setting: the one rule every source of it is checked by (the flag,
+/// `--config`, a folder `g2tess.toml`, a sidecar, glTF `extras`), and the one text `--help`,
+/// `config/default.toml` and the README print for it (tests compare them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Setting {
+    /// The key in TOML files (the flag is `--` and the key with `-` for `_`).
+    pub key: &'static str,
+    /// The default, as written in every document.
+    pub default: f64,
+    /// Smallest accepted value.
+    pub min: f64,
+    /// Largest accepted value.
+    pub max: f64,
+    /// Whole numbers only.
+    pub integer: bool,
+    /// Unit after the range in messages (`" degrees"`), or empty.
+    pub unit: &'static str,
+}
+
+/// `level`: segments per input edge.
+pub const LEVEL: Setting = Setting {
+    key: "level",
+    default: DEFAULT_LEVEL as f64,
+    min: 1.0,
+    max: MAX_LEVEL as f64,
+    integer: true,
+    unit: "",
+};
+/// `h`: blend width in the reference triangle; up to [`MAX_H_SHOWN`], clamped to [`MAX_H`].
+pub const H: Setting = Setting {
+    key: "h",
+    default: DEFAULT_H,
+    min: 0.0,
+    max: MAX_H_SHOWN,
+    integer: false,
+    unit: "",
+};
+/// `crease_angle`: degrees between face normals.
+pub const CREASE_ANGLE: Setting = Setting {
+    key: "crease_angle",
+    default: DEFAULT_CREASE_ANGLE,
+    min: 0.0,
+    max: 180.0,
+    integer: false,
+    unit: " degrees",
+};
+/// `coons_lambda`: the Coons scheme's shape parameter.
+pub const COONS_LAMBDA: Setting = Setting {
+    key: "coons_lambda",
+    default: DEFAULT_COONS_LAMBDA,
+    min: 0.05,
+    max: 0.95,
+    integer: false,
+    unit: "",
+};
+/// Every numeric setting with a range.
+pub const RANGED_SETTINGS: [Setting; 4] = [LEVEL, H, CREASE_ANGLE, COONS_LAMBDA];
+
+impl Setting {
+    /// `"0 to 0.3536"`: the range as every message and document prints it.
+    pub fn range_text(&self) -> String {
+        format!("{} to {}", self.min, self.max)
+    }
+
+    /// Whether `value` is in range (NaN never is).
+    pub fn contains(&self, value: f64) -> bool {
+        (self.min..=self.max).contains(&value) && (!self.integer || value.fract() == 0.0)
+    }
+
+    /// `value` if in range, else `"is 65 (expected 1 to 64)"`.
+    pub fn check(&self, value: f64) -> Result<f64, String> {
+        if self.contains(value) {
+            Ok(value)
+        } else {
+            Err(format!(
+                "is {value} (expected {}{})",
+                self.range_text(),
+                self.unit
+            ))
+        }
+    }
+}
+
+/// `h` as the surface uses it: in range values above √2/4 (up to the printed [`MAX_H_SHOWN`])
+/// become √2/4.
+pub fn clamp_h(h: f64) -> f64 {
+    h.min(MAX_H)
+}
 
 /// Every setting, resolved. Defaults are the `DEFAULT_*` constants of this module.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,6 +196,34 @@ pub struct Options {
     /// primitive ([`crate::pipeline::PrimitiveReport::cache`], a sequential pass over the index
     /// buffer). It changes the report, never the output. Default: `false`.
     pub report_figures: bool,
+    /// A flag the caller sets to stop the work early (the CLI's Ctrl-C and SIGTERM): polled
+    /// between stages of every mesh, it fails the file with [`crate::pipeline::Error::Cancelled`]
+    /// instead of finishing it. Default: none (never cancelled).
+    pub cancel: Cancel,
+}
+
+/// An optional stop flag; it never takes part in comparing options (two runs that differ only
+/// in how they can be stopped make the same output).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Cancel(Option<&'static std::sync::atomic::AtomicBool>);
+
+impl Cancel {
+    /// Cancelled once `flag` is set.
+    pub fn on(flag: &'static std::sync::atomic::AtomicBool) -> Self {
+        Cancel(Some(flag))
+    }
+
+    /// Whether the work should stop.
+    pub fn requested(&self) -> bool {
+        self.0
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+    }
+}
+
+impl PartialEq for Cancel {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl Default for Options {
@@ -122,6 +247,7 @@ impl Default for Options {
             compress: DEFAULT_COMPRESS,
             compress_fallback: DEFAULT_COMPRESS_FALLBACK,
             report_figures: false,
+            cancel: Cancel::default(),
         }
     }
 }
@@ -207,26 +333,15 @@ impl Options {
                 what,
             })
         };
-        if !(1..=MAX_LEVEL).contains(&self.level) {
-            return err(
-                "level",
-                format!("is {} (expected 1 to {MAX_LEVEL})", self.level),
-            );
-        }
-        if !(0.0..=MAX_H).contains(&self.h) {
-            return err("h", format!("is {} (expected 0 to {MAX_H:.4})", self.h));
-        }
-        if !(0.0..=180.0).contains(&self.crease_angle) {
-            return err(
-                "crease_angle",
-                format!("is {} (expected 0 to 180 degrees)", self.crease_angle),
-            );
-        }
-        if !(0.05..=0.95).contains(&self.coons_lambda) {
-            return err(
-                "coons_lambda",
-                format!("is {} (expected 0.05 to 0.95)", self.coons_lambda),
-            );
+        for (setting, value) in [
+            (LEVEL, f64::from(self.level)),
+            (H, self.h),
+            (CREASE_ANGLE, self.crease_angle),
+            (COONS_LAMBDA, self.coons_lambda),
+        ] {
+            if let Err(what) = setting.check(value) {
+                return err(setting.key, what);
+            }
         }
         if self.max_output_triangles == 0 {
             return err("max_output_triangles", "is 0 (expected at least 1)".into());
@@ -288,5 +403,28 @@ mod tests {
             .unwrap_err()
             .what
             .contains("expected 0 to 0.3536"));
+    }
+
+    /// The printed bound of h is accepted (and clamped to √2/4 where used); just above it is
+    /// not. Level, crease angle and λ refuse just past either end.
+    #[test]
+    fn ranges_accept_their_printed_ends() {
+        for setting in RANGED_SETTINGS {
+            assert!(setting.check(setting.min).is_ok(), "{}", setting.key);
+            assert!(setting.check(setting.max).is_ok(), "{}", setting.key);
+            let past = if setting.integer { 1.0 } else { 1e-4 };
+            for bad in [setting.min - past, setting.max + past, f64::NAN] {
+                let what = setting.check(bad).unwrap_err();
+                assert!(what.contains(&setting.range_text()), "{what}");
+            }
+        }
+        assert_eq!(H.max, 0.3536);
+        assert_eq!(clamp_h(0.3536), MAX_H);
+        assert_eq!(clamp_h(0.2), 0.2);
+        let o = Options {
+            h: 0.3536,
+            ..Options::default()
+        };
+        assert!(o.validate("--h").is_ok());
     }
 }

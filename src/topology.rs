@@ -47,7 +47,8 @@ pub struct Edge {
     pub verts: [VertId; 2],
     /// Classification; non-interior edges act as h = 0.
     pub kind: EdgeKind,
-    /// Every use of the edge: the triangle and its local corner opposite the edge.
+    /// Every use of the edge: the triangle and its local corner opposite the edge, in
+    /// (triangle, corner) order, so the first use is the lowest-numbered triangle.
     pub tris: EdgeUses,
     /// The triangles using the edge carry different input normals at one of its end points
     /// (exact comparison: a hard edge, or a UV seam with slightly different normals).

@@ -159,3 +159,102 @@ fn guarded_run_reports_errors_like_the_plain_one() {
         format!("{}: internal error: index out of bounds (this is a bug in g2tess, not in the file; please report it with the file)", missing.display())
     );
 }
+
+/// The documented bound of h, 0.3536 (√2/4 rounded up), is accepted from the flag, the
+/// `--config` file and a sidecar alike; just above it is refused by each with the same range.
+#[test]
+fn the_printed_h_bound_is_accepted_by_every_source() {
+    let dir = corpus::temp_dir();
+    let input = hostile::write_tetrahedron(dir.path(), "t.gltf", "t.bin", Some(Path::new("t.bin")));
+    let out = dir.path().join("out.glb");
+    let config = dir.path().join("c.toml");
+    let sidecar = dir.path().join("s.toml");
+    for (h, ok) in [("0.3536", true), ("0.3537", false)] {
+        std::fs::write(&config, format!("h = {h}\n")).unwrap();
+        std::fs::write(&sidecar, format!("h = {h}\n")).unwrap();
+        for extra in [
+            vec!["--h", h],
+            vec!["--config", config.to_str().unwrap()],
+            vec!["--sidecar", sidecar.to_str().unwrap()],
+        ] {
+            let mut args = vec![input.to_str().unwrap(), "-o", out.to_str().unwrap()];
+            args.extend(&extra);
+            let run = run_limited(&args, None);
+            if ok {
+                assert_eq!(run.code, Some(0), "{extra:?}: {}", run.stderr);
+            } else {
+                assert_ne!(run.code, Some(0), "{extra:?} accepted h = {h}");
+                assert!(
+                    run.stderr.contains("0 to 0.3536") || run.stderr.contains("[0, 0.3536]"),
+                    "{extra:?}: {}",
+                    run.stderr
+                );
+            }
+        }
+    }
+}
+
+/// A sidecar `level` beyond 64 is refused like `--level 65`, not accepted (65–255) or left to an
+/// internal assertion (256 and more).
+#[test]
+fn a_sidecar_level_past_64_is_refused() {
+    let dir = corpus::temp_dir();
+    let input = hostile::write_tetrahedron(dir.path(), "t.gltf", "t.bin", Some(Path::new("t.bin")));
+    let out = dir.path().join("out.glb");
+    for level in [65, 255, 256, 100_000] {
+        std::fs::write(
+            dir.path().join("t.g2tess.toml"),
+            format!("level = {level}\n"),
+        )
+        .unwrap();
+        let run = run_limited(&[input.as_os_str(), "-o".as_ref(), out.as_os_str()], None);
+        assert_eq!(verdict(&run), None, "{run:?}");
+        assert_eq!(run.code, Some(1), "level {level}: {}", run.stderr);
+        assert!(
+            run.stderr
+                .contains(&format!("level must be in [1, 64], got {level}")),
+            "{}",
+            run.stderr
+        );
+    }
+}
+
+/// One SIGTERM stops the file in flight between its stages: exit status 130 and no output,
+/// where it used to finish the file (6.4 million output triangles here) first.
+#[test]
+fn sigterm_stops_the_file_in_flight() {
+    let dir = corpus::temp_dir();
+    // A fan of 100 000 triangles at level 8: about two seconds of work.
+    let n = 100_000u32;
+    let turn = |i: u32| std::f32::consts::TAU * i as f32 / n as f32;
+    let mut p = vec![[0.0f32, 0.0, 0.0]];
+    p.extend((0..n).map(|i| [turn(i).cos(), turn(i).sin(), 0.3 * (7.0 * turn(i)).sin()]));
+    let normals = vec![[0.0f32, 0.0, 1.0]; p.len()];
+    let idx: Vec<u32> = (0..n).flat_map(|i| [0, i + 1, (i + 1) % n + 1]).collect();
+    let input = hostile::write_mesh(dir.path(), &p, Some(&normals), &idx);
+    let output = dir.path().join("out.glb");
+    let child = corpus::g2tess()
+        .args([
+            input.as_os_str(),
+            "-o".as_ref(),
+            output.as_os_str(),
+            "--level".as_ref(),
+            "8".as_ref(),
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(700));
+    let killed = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(
+        !output.exists(),
+        "the file in flight was finished: {stderr}"
+    );
+}

@@ -214,8 +214,8 @@ fn first_reference_order(indices: &[u32]) -> Vec<usize> {
         .collect()
 }
 
-/// Identity: the same triangles over the same positions and normals, bit for bit (a normal that
-/// was not unit length comes out normalized), and every other attribute carried unchanged.
+/// Identity: the same triangles over the same positions and normals, bit for bit (a normal
+/// further from unit length than the validator allows comes out normalized), and every other attribute carried unchanged.
 fn assert_same_geometry(input: &Document, output: &Document, name: &str) {
     assert_eq!(
         input.triangle_primitives(),
@@ -258,8 +258,15 @@ fn assert_same_geometry(input: &Document, output: &Document, name: &str) {
             for (k, &v) in order.iter().enumerate() {
                 let (want, got) = (&x[v * c..v * c + c], &y[k * c..k * c + c]);
                 if attr.name == "NORMAL" {
-                    let len = want.iter().map(|w| w * w).sum::<f32>().sqrt();
-                    if (len - 1.0).abs() >= 1e-6 {
+                    // Kept bit for bit when unit to the validator's tolerance (the Teapot's
+                    // are within 5e-5 of it), normalized beyond it.
+                    let len = want
+                        .iter()
+                        .map(|&w| f64::from(w).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    if (len - 1.0).abs() > 0.00769 {
+                        let len = len as f32;
                         let normalized: Vec<f32> = want.iter().map(|w| w / len).collect();
                         let close = normalized
                             .iter()

@@ -130,6 +130,37 @@ fn h_from_each_source_lands_on_the_edge_it_names() {
     }
 }
 
+/// Two meshes of one name: `--explain-h NAME` is refused like a sidecar section of that name
+/// (it picked the first), and the index still works.
+#[test]
+fn explain_h_refuses_a_name_two_meshes_share() {
+    let dir = corpus::temp_dir();
+    let text = gltf("Gem", None, &[octahedron()]);
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let mesh = doc["meshes"][0].clone();
+    doc["meshes"].as_array_mut().unwrap().push(mesh);
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "mesh": 1 }));
+    let nodes = doc["nodes"].as_array().unwrap().len();
+    doc["scenes"][0]["nodes"] = json!((0..nodes).collect::<Vec<_>>());
+    std::fs::write(dir.path().join("two.gltf"), doc.to_string()).unwrap();
+    let out = run(dir.path(), &["two.gltf", "--explain-h", "Gem"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--explain-h Gem: mesh name \"Gem\" is shared by meshes 0, 1; name the mesh by index, e.g. --explain-h 0"),
+        "{err}"
+    );
+    let out = run(dir.path(), &["two.gltf", "--explain-h", "1"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 #[test]
 fn explain_h_names_the_source_of_every_edge() {
     let dir = corpus::temp_dir();

@@ -92,11 +92,18 @@ fn sidecar_crease_angle_out_of_range() {
 }
 
 #[test]
-fn sidecar_level_must_be_positive_integer() {
+fn sidecar_level_has_the_range_of_the_flag() {
     assert_eq!(
         sidecar_error("level = 0\n"),
-        "robot.g2tess.toml:1: level: level must be at least 1, got 0"
+        "robot.g2tess.toml:1: level: level must be in [1, 64], got 0"
     );
+    // Past the documented 64, and past what one output vertex can record (255).
+    for level in [65_i64, 256, 1 << 40] {
+        assert_eq!(
+            sidecar_error(&format!("level = {level}\n")),
+            format!("robot.g2tess.toml:1: level: level must be in [1, 64], got {level}")
+        );
+    }
     assert!(sidecar_error("level = 2.5\n").starts_with("robot.g2tess.toml:1: invalid type"));
 }
 

@@ -58,7 +58,8 @@ pub struct Args {
     #[arg(long, value_enum, help_heading = "Surface")]
     pub nets: Option<NetsArg>,
 
-    /// Coons shape parameter λ of seed 002, 0.05 to 0.95 [default: 0.5]
+    /// Coons shape parameter λ (Szilvási-Nagy and Szabó's Coons-type blending), 0.05 to 0.95
+    /// [default: 0.5]
     #[arg(long, value_name = "L", help_heading = "Surface")]
     pub coons_lambda: Option<f64>,
 
@@ -322,6 +323,8 @@ impl Layers {
         let mut opts = opts.overlay(&self.flags);
         opts.sidecar = self.sidecar.clone();
         opts.report_figures = self.report_figures;
+        // Ctrl-C and SIGTERM stop the file in flight between its stages, not after it.
+        opts.cancel = options::Cancel::on(super::interrupt::flag());
         opts.validate("command line")?;
         Ok(opts)
     }

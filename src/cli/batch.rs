@@ -178,6 +178,8 @@ fn write_one(job: &Job, options: &Options) -> Outcome {
             report: Some(report),
             ..Outcome::new(Status::Done)
         },
+        // Stopped by Ctrl-C or SIGTERM between stages: nothing was written.
+        Err(pipeline::Error::Cancelled { .. }) => Outcome::new(Status::Cancelled),
         Err(e) => Outcome::failed(e.to_string()),
     }
 }

@@ -75,7 +75,15 @@ impl Attribute {
         }
     }
 
-    /// Its values as float 3-vectors, if that is what it holds.
+    /// The values of a float attribute of any component count (integer ones are `None`).
+    pub fn floats(&self) -> Option<&[f32]> {
+        match &self.values {
+            Values::Float(v) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// The values of a three-component float attribute (positions, normals, morph deltas).
     pub fn vec3(&self) -> Option<&[f32]> {
         match &self.values {
             Values::Float(v) if self.components == 3 => Some(v),

@@ -549,6 +549,18 @@ fn unit_vectors(acc: &Accessor, at: &str, tangent: bool) -> Result<()> {
     let v = acc.to_f32();
     let n = acc.components;
     for (e, chunk) in v.chunks_exact(n).enumerate() {
+        if chunk.iter().any(|x| !x.is_finite()) {
+            return Err(Error::invalid(
+                at,
+                format!("element {e} is not finite (expected a unit vector)"),
+            ));
+        }
+        // A normal's direction is all the surface needs: the pipeline normalizes one of another
+        // length and rebuilds a zero one (an exporter's "no normal here") from the faces
+        // around its vertex, each with a warning. Only a tangent's length is checked here.
+        if !tangent {
+            continue;
+        }
         let len = (chunk[..3].iter().map(|x| (*x as f64).powi(2)).sum::<f64>()).sqrt();
         if (len - 1.0).abs() > UNIT_TOLERANCE {
             return Err(Error::invalid(

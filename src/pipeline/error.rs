@@ -36,6 +36,13 @@ pub enum Error {
         /// The panic's message.
         what: String,
     },
+    /// The caller asked to stop ([`crate::options::Options::cancel`]) before the file was done;
+    /// nothing was written.
+    #[error("{}: cancelled", file.display())]
+    Cancelled {
+        /// The asset.
+        file: PathBuf,
+    },
     /// The work would exceed a resource bound.
     #[error("{}: {what}", file.display())]
     Limit {

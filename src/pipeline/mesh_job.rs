@@ -34,6 +34,8 @@ pub struct PrimitiveInput {
     pub extras: Option<Value>,
     /// `Some(texcoord set)` when tangents must be generated (see the pipeline's rule).
     pub needs_tangents: Option<u32>,
+    /// The accessor of its NORMAL, named in the warning about repaired normals.
+    pub normal_accessor: Option<usize>,
     /// The decoded arrays.
     pub data: PrimitiveData,
 }
@@ -139,6 +141,7 @@ pub fn smooth_mesh(
         name: input.name.clone(),
         ..MeshReport::default()
     };
+    stop_if_cancelled(options, asset)?;
     let clock = Instant::now();
     let Resolved {
         prepared,
@@ -148,26 +151,36 @@ pub fn smooth_mesh(
         params,
     } = resolve(input, sharpness, options, asset, &mut report.warnings)?;
     report.times.sharpness = lap(&clock, 0.0);
+    stop_if_cancelled(options, asset)?;
 
-    let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &params.h);
+    let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &params.effective);
     report.warnings.extend(
         surface_warnings
             .into_iter()
             .map(|w| format!("mesh {}: {w}", input.mesh)),
     );
     report.edges = if options.report_figures {
-        EdgeFigures::measure(surface.as_ref(), &topo, &params.h)
+        EdgeFigures::measure(surface.as_ref(), &topo, &params.effective)
     } else {
-        EdgeFigures::count(&topo, &params.h)
+        EdgeFigures::count(&topo, &params.effective)
     };
     report.times.surface = lap(&clock, report.times.sharpness);
+    stop_if_cancelled(options, asset)?;
 
     let tess_start = Instant::now();
-    let mut dense = tessellate(&mesh, &topo, &params.h, surface.as_ref(), level, &groups);
+    let mut dense = tessellate(
+        &mesh,
+        &topo,
+        &params.effective,
+        surface.as_ref(),
+        level,
+        &groups,
+    );
     report.times.tessellate = tess_start.elapsed().as_secs_f64();
     // The surface holds about 1 kB per input triangle: free it before the attributes are
     // carried, when the dense mesh is at its largest.
     drop(surface);
+    stop_if_cancelled(options, asset)?;
 
     // The tessellator already emits cache-friendly bands with vertices in first-use order:
     // meshoptimizer's vertex cache pass made both figures worse on its output and took longer
@@ -182,7 +195,14 @@ pub fn smooth_mesh(
     let attr_start = Instant::now();
     let mut primitives = Vec::with_capacity(prepared.len());
     let targets = morph::targets(
-        &mesh, &topo, &params.h, &prepared, &groups, level, options, &remaps,
+        &mesh,
+        &topo,
+        &params.effective,
+        &prepared,
+        &groups,
+        level,
+        options,
+        &remaps,
     );
     for (k, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
         report.primitives.push(PrimitiveReport {
@@ -194,10 +214,58 @@ pub fn smooth_mesh(
             cache: options.report_figures.then(|| optimize::cache_figures(&d)),
         });
         let data = primitive_out::build(prep, d, groups[k].start as u32, target);
+        refuse_non_finite(&data, input.mesh, input.primitives[k].index, options)
+            .map_err(|e| Error::gltf(asset, e))?;
         primitives.push((input.primitives[k].index, data));
     }
     report.times.attributes = attr_start.elapsed().as_secs_f64();
     Ok(MeshOutput { primitives, report })
+}
+
+/// No output value is ever non-finite: a surface that overflows f32 (coordinates near its
+/// largest value, where a scheme's control points leave the range) fails the file with the
+/// primitive and attribute named, instead of writing Infinity or NaN that the validator rejects.
+fn refuse_non_finite(
+    data: &PrimitiveData,
+    mesh: usize,
+    prim: usize,
+    options: &Options,
+) -> Result<(), gltf_io::Error> {
+    let at = format!("meshes[{mesh}].primitives[{prim}]");
+    let lists = data.attributes.iter().map(|a| (a, String::new())).chain(
+        data.targets
+            .iter()
+            .enumerate()
+            .flat_map(|(t, attrs)| attrs.iter().map(move |a| (a, format!("targets[{t}].")))),
+    );
+    for (a, target) in lists {
+        let Some(v) = a.floats() else {
+            continue;
+        };
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            return Err(gltf_io::Error::invalid(
+                format!("{at}.{target}attributes.{}", a.name),
+                format!(
+                    "the {} surface reaches {} at output vertex {} (expected finite 32-bit floats; the input's coordinates are too close to the largest float for this scheme: scale the mesh down)",
+                    options.scheme.name(),
+                    v[i],
+                    i / a.components.max(1)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// [`Error::Cancelled`] once the caller's stop flag is set: polled between stages, so a stop
+/// waits at most for one stage of one mesh.
+pub(super) fn stop_if_cancelled(options: &Options, asset: &Path) -> Result<(), Error> {
+    if options.cancel.requested() {
+        return Err(Error::Cancelled {
+            file: asset.to_path_buf(),
+        });
+    }
+    Ok(())
 }
 
 /// Seconds since `clock` minus what earlier stages already took.
@@ -246,24 +314,31 @@ fn prepare(
     let input_normals = data.normals();
     match input_normals {
         Some(n) => {
-            let mut repaired = 0;
-            let normals: Vec<DVec3> = n
+            let raw: Vec<DVec3> = n
                 .chunks_exact(3)
-                .enumerate()
-                .map(|(v, c)| {
-                    let d = DVec3::new(c[0].into(), c[1].into(), c[2].into());
-                    let unit = d.normalize_or_zero();
-                    if unit == DVec3::ZERO || !unit.is_finite() {
-                        repaired += 1;
-                        fallback_normal(&points, &triangles, v as u32)
-                    } else {
-                        unit
-                    }
-                })
+                .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
                 .collect();
-            if repaired > 0 {
+            let mut normals: Vec<DVec3> = raw.iter().map(|d| d.normalize_or_zero()).collect();
+            let rescaled: Vec<usize> = (0..raw.len())
+                .filter(|&v| normals[v] != DVec3::ZERO && !unit_to_validator(raw[v]))
+                .collect();
+            if let Some(&first) = rescaled.first() {
                 warnings.push(format!(
-                    "{at}.attributes.NORMAL: {repaired} zero or non-finite normals replaced by the mean of their faces' normals"
+                    "{at}.attributes.NORMAL{}: {} normals not of unit length (first: vertex {first}, length {}) normalized",
+                    accessor_label(input.normal_accessor),
+                    rescaled.len(),
+                    raw[first].length() as f32
+                ));
+            }
+            let broken: Vec<usize> = (0..normals.len())
+                .filter(|&v| normals[v] == DVec3::ZERO || !normals[v].is_finite())
+                .collect();
+            if let Some(&first) = broken.first() {
+                repair_normals(&points, &triangles, &broken, &mut normals);
+                let accessor = accessor_label(input.normal_accessor);
+                warnings.push(format!(
+                    "{at}.attributes.NORMAL{accessor}: {} zero-length normals (first: vertex {first}) replaced by the angle-weighted normal of their faces",
+                    broken.len()
                 ));
             }
             Ok(Prepared::new(
@@ -289,21 +364,48 @@ fn prepare(
     }
 }
 
-/// The normalized sum of the normals of the faces around input vertex `v` (or +Z).
-fn fallback_normal(points: &[DVec3], triangles: &[[u32; 3]], v: u32) -> DVec3 {
-    let sum: DVec3 = triangles
-        .iter()
-        .filter(|t| t.contains(&v))
-        .map(|t| {
-            let [a, b, c] = t.map(|i| points[i as usize]);
-            (b - a).cross(c - a)
-        })
-        .sum();
-    let n = sum.normalize_or_zero();
-    if n == DVec3::ZERO {
-        DVec3::Z
-    } else {
-        n
+/// `" (accessors[3])"`, or nothing when the accessor is not known.
+fn accessor_label(accessor: Option<usize>) -> String {
+    accessor.map_or(String::new(), |a| format!(" (accessors[{a}])"))
+}
+
+/// Whether `n` is unit length within the Khronos validator's tolerance for unit vectors.
+fn unit_to_validator(n: DVec3) -> bool {
+    (n.length() - 1.0).abs() <= 0.00769
+}
+
+/// Replaces `normals[v]` for every `v` in `broken` (sorted) by the angle-weighted sum of the
+/// unit normals of the faces around input vertex `v`, normalized (+Z where every face is
+/// degenerate): one pass over the triangles, whatever the number of broken normals.
+fn repair_normals(
+    points: &[DVec3],
+    triangles: &[[u32; 3]],
+    broken: &[usize],
+    normals: &mut [DVec3],
+) {
+    let mut is_broken = vec![false; normals.len()];
+    for &v in broken {
+        is_broken[v] = true;
+    }
+    let mut sums = vec![DVec3::ZERO; normals.len()];
+    for t in triangles {
+        if !t.iter().any(|&v| is_broken[v as usize]) {
+            continue;
+        }
+        let p = t.map(|v| points[v as usize]);
+        let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        for k in 0..3 {
+            let v = t[k] as usize;
+            if is_broken[v] {
+                let angle = (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]);
+                if angle.is_finite() {
+                    sums[v] += angle * face;
+                }
+            }
+        }
+    }
+    for &v in broken {
+        normals[v] = sums[v].normalize_or(DVec3::Z);
     }
 }
 

@@ -176,6 +176,13 @@ fn mesh_inputs(doc: &Document, asset: &Path) -> Result<Vec<MeshInput>, Error> {
             index: prim,
             extras: doc.primitive_extras(mesh, prim),
             needs_tangents: needs_tangents(doc, mesh, prim, &data),
+            normal_accessor: doc
+                .raw
+                .pointer(&format!(
+                    "/meshes/{mesh}/primitives/{prim}/attributes/NORMAL"
+                ))
+                .and_then(serde_json::Value::as_u64)
+                .map(|a| a as usize),
             data,
         });
     }
@@ -204,9 +211,31 @@ pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<Str
     let doc = gltf_io::read(input, &options.read_options()).map_err(|e| Error::gltf(input, e))?;
     let sharpness = asset_sharpness(&doc, input, options)?;
     let inputs = mesh_inputs(&doc, input)?;
-    let found = inputs.iter().find(|m| {
-        m.name.as_deref() == Some(which) || which.parse::<usize>().is_ok_and(|i| i == m.mesh)
-    });
+    // As in a sidecar section: digits name an index, anything else a name, which must be
+    // unique among the meshes with triangles.
+    let by_index = !which.is_empty() && which.bytes().all(|b| b.is_ascii_digit());
+    let hits: Vec<&mesh_job::MeshInput> = inputs
+        .iter()
+        .filter(|m| {
+            if by_index {
+                which.parse::<usize>().is_ok_and(|i| i == m.mesh)
+            } else {
+                m.name.as_deref() == Some(which)
+            }
+        })
+        .collect();
+    if let [first, _, ..] = hits.as_slice() {
+        let indices: Vec<String> = hits.iter().map(|m| m.mesh.to_string()).collect();
+        return Err(Error::Request {
+            file: input.to_path_buf(),
+            what: format!(
+                "--explain-h {which}: mesh name \"{which}\" is shared by meshes {}; name the mesh by index, e.g. --explain-h {}",
+                indices.join(", "),
+                first.mesh
+            ),
+        });
+    }
+    let found = hits.first().copied();
     let Some(mesh) = found else {
         let known: Vec<String> = inputs
             .iter()

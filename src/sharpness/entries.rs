@@ -6,7 +6,6 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use super::error::{Location, Problem, SharpnessError};
-use super::H_MAX;
 
 /// A value together with where it was written, so precedence winners can be explained.
 #[derive(Debug, Clone, PartialEq)]
@@ -89,21 +88,28 @@ impl RawEdgeFields {
 }
 
 /// h is a length in the paper's reference triangle, so its range is fixed: out of range is a
-/// mistake to report, never a value to clamp silently.
+/// mistake to report, never a value to clamp silently. The range is the options' one
+/// ([`crate::options::H`]); the printed bound 0.3536 is accepted and becomes √2/4.
 pub(crate) fn check_h(h: f64) -> Result<f64, Problem> {
-    if (0.0..=H_MAX).contains(&h) {
-        Ok(h)
-    } else {
-        Err(Problem::HOutOfRange { got: h })
+    match crate::options::H.check(h) {
+        Ok(h) => Ok(crate::options::clamp_h(h)),
+        Err(_) => Err(Problem::HOutOfRange { got: h }),
     }
 }
 
-/// The crease angle is the angle between two face normals, so it lives in [0, 180] degrees.
+/// The crease angle is the angle between two face normals, so it lives in [0, 180] degrees
+/// ([`crate::options::CREASE_ANGLE`]).
 pub(crate) fn check_crease_angle(degrees: f64) -> Result<f64, Problem> {
-    if (0.0..=180.0).contains(&degrees) {
-        Ok(degrees)
-    } else {
-        Err(Problem::CreaseAngleOutOfRange { got: degrees })
+    crate::options::CREASE_ANGLE
+        .check(degrees)
+        .map_err(|_| Problem::CreaseAngleOutOfRange { got: degrees })
+}
+
+/// A sidecar's `level` follows the same rule as `--level` ([`crate::options::LEVEL`]).
+pub(crate) fn check_level(level: i64) -> Result<u32, Problem> {
+    match crate::options::LEVEL.check(level as f64) {
+        Ok(_) => Ok(level as u32),
+        Err(_) => Err(Problem::LevelOutOfRange { got: level }),
     }
 }
 

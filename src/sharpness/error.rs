@@ -4,8 +4,6 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use super::H_MAX;
-
 /// Where a value or a mistake sits: shown in front of every error message and in explain rows.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Location {
@@ -56,11 +54,11 @@ struct Located {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum Problem {
-    #[error("h must be in [0, {:.4}], got {got}", H_MAX)]
+    #[error("h must be in [{}, {}], got {got}", crate::options::H.min, crate::options::H.max)]
     HOutOfRange { got: f64 },
-    #[error("crease_angle must be in [0, 180] degrees, got {got}")]
+    #[error("crease_angle must be in [{}, {}] degrees, got {got}", crate::options::CREASE_ANGLE.min, crate::options::CREASE_ANGLE.max)]
     CreaseAngleOutOfRange { got: f64 },
-    #[error("level must be at least 1, got {got}")]
+    #[error("level must be in [{}, {}], got {got}", crate::options::LEVEL.min, crate::options::LEVEL.max)]
     LevelOutOfRange { got: i64 },
     #[error("expected {expected}, got {got}")]
     WrongType { expected: &'static str, got: String },

@@ -59,9 +59,8 @@ use crate::topology::{EdgeKind, Topology};
 use entries::at;
 use sidecar::MeshKey;
 
-/// The largest blend width: sqrt(2)/4, a quarter of the reference triangle's side, where the
-/// blending regions of a triangle's three edges meet.
-pub const H_MAX: f64 = std::f64::consts::SQRT_2 / 4.0;
+/// The largest blend width, √2/4: the surface's one definition, re-exported.
+pub use crate::surface::H_MAX;
 
 /// `from`/`to` positions match a welded vertex within this fraction of the mesh's bounding-box
 /// diagonal: loose enough for float round trips through other tools, far below any edge length.
@@ -106,7 +105,12 @@ pub struct PrimitiveContext<'a> {
 /// One h per welded edge (indexed by [`crate::topology::EdgeId`]), why, and what looked odd.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeParams {
+    /// The h each edge's sources ask for (what `--explain-h` shows), in range.
     pub h: Vec<f64>,
+    /// The h each edge is built with: `h` clamped to √2/4 on interior edges, 0 on boundary,
+    /// non-manifold and degenerate ones. Decided once here; the surfaces, the tessellator's
+    /// creases, the morph targets and the report all read it.
+    pub effective: Vec<f64>,
     pub sources: Vec<HSource>,
     pub warnings: Vec<SharpnessWarning>,
 }
@@ -161,7 +165,8 @@ impl AssetSharpness {
         mesh_names: &[Option<&str>],
         defaults: Defaults,
     ) -> Result<Self, SharpnessError> {
-        entries::check_h(defaults.h).map_err(|p| at(&Location::Options, p))?;
+        let mut defaults = defaults;
+        defaults.h = entries::check_h(defaults.h).map_err(|p| at(&Location::Options, p))?;
         entries::check_crease_angle(defaults.crease_angle)
             .map_err(|p| at(&Location::Options, p))?;
         let mut section_of_mesh: HashMap<usize, usize> = HashMap::new();

@@ -78,6 +78,7 @@ pub(crate) fn resolve(
     let prim_of_tri = primitive_of_triangle(ctx, mesh);
 
     let mut h = Vec::with_capacity(topo.edges.len());
+    let mut effective = Vec::with_capacity(topo.edges.len());
     let mut sources = Vec::with_capacity(topo.edges.len());
     for (e, edge) in topo.edges.iter().enumerate() {
         let id = EdgeId(e as u32);
@@ -138,14 +139,29 @@ pub(crate) fn resolve(
         } else {
             (asset.defaults.h, HSource::Options)
         };
+        effective.push(effective_h(edge.kind, value));
         h.push(value);
         sources.push(source);
     }
     Ok(EdgeParams {
         h,
+        effective,
         sources,
         warnings,
     })
+}
+
+/// The h an edge is built with, decided here once for every later stage: the resolved value
+/// (already in range, the printed bound clamped to √2/4) on interior edges, 0 on boundary,
+/// non-manifold and degenerate edges, which the surface never blends. An explicit entry asking
+/// for more on such an edge is warned about where it is read ([`Explicit::note`]); a default
+/// that merely covers it is not, so an open mesh at default settings gives no warning.
+fn effective_h(kind: EdgeKind, value: f64) -> f64 {
+    if kind == EdgeKind::Interior {
+        crate::options::clamp_h(value)
+    } else {
+        0.0
+    }
 }
 
 /// The crease rule for one edge: the sharpest crease angle over its sides (the options' when no

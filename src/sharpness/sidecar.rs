@@ -11,7 +11,9 @@ use glam::DVec3;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::entries::{at, check_crease_angle, check_h, Block, EdgeEntry, Located, RawEdgeFields};
+use super::entries::{
+    at, check_crease_angle, check_h, check_level, Block, EdgeEntry, Located, RawEdgeFields,
+};
 use super::error::{Location, Problem, SharpnessError};
 
 /// The suffix that turns an asset's stem into its sidecar's file name.
@@ -142,17 +144,9 @@ impl Sidecar {
         };
         let level = match raw.level {
             None => None,
-            Some(level) => match u32::try_from(*level.get_ref()) {
-                Ok(n) if n >= 1 => Some(n),
-                _ => {
-                    return Err(at(
-                        &loc(level.span(), "level"),
-                        Problem::LevelOutOfRange {
-                            got: *level.get_ref(),
-                        },
-                    ))
-                }
-            },
+            Some(level) => Some(
+                check_level(*level.get_ref()).map_err(|p| at(&loc(level.span(), "level"), p))?,
+            ),
         };
         let mut meshes = Vec::with_capacity(raw.mesh.len());
         for (key, section) in raw.mesh {
@@ -183,7 +177,7 @@ impl Sidecar {
         &self.file
     }
 
-    /// The per-asset tessellation level, if the sidecar sets one (at least 1).
+    /// The per-asset tessellation level, if the sidecar sets one (in the range of `--level`).
     pub fn level(&self) -> Option<u32> {
         self.level
     }

@@ -178,9 +178,12 @@ struct EdgeSamples {
 }
 
 /// The triangle that evaluates the samples of welded edge `e` for everyone, and the corner its
-/// side of the edge is opposite: the edge's lowest-numbered triangle.
+/// side of the edge is opposite: the edge's lowest-numbered triangle, its first use (the uses
+/// are kept in (triangle, corner) order, see [`crate::topology::Edge::tris`]). Reading the first
+/// use instead of searching them all keeps this constant time: it is asked once per triangle
+/// side, so a search made a book of many triangles on one edge quadratic.
 fn evaluator(topo: &Topology, e: usize) -> Option<(usize, usize)> {
-    let &(tri, k) = topo.edges[e].tris.iter().min_by_key(|&&(t, k)| (t.0, k))?;
+    let &(tri, k) = topo.edges[e].tris.first()?;
     Some((tri.0 as usize, k as usize))
 }
 

@@ -211,6 +211,20 @@ pub fn mesh_gltf(
     (json, bin)
 }
 
+/// Writes [`mesh_gltf`] of the mesh as `t.gltf` + `t.bin` into `dir`; returns the `.gltf` path.
+pub fn write_mesh(
+    dir: &Path,
+    positions: &[[f32; 3]],
+    normals: Option<&[[f32; 3]]>,
+    indices: &[u32],
+) -> std::path::PathBuf {
+    let (json, bin) = mesh_gltf(positions, normals, indices, "t.bin");
+    std::fs::write(dir.join("t.bin"), bin).unwrap();
+    let input = dir.join("t.gltf");
+    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    input
+}
+
 /// A closed tetrahedron (4 vertices, 4 triangles wound outward), the smallest closed mesh.
 pub fn tetrahedron() -> (Vec<[f32; 3]>, Vec<u32>) {
     (
