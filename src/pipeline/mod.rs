@@ -217,6 +217,38 @@ pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<Str
         .collect())
 }
 
+/// One mesh's welded edges and the h resolved for each, as the surface would use them.
+#[derive(Debug, Clone)]
+pub struct ResolvedEdges {
+    /// The glTF mesh.
+    pub mesh: usize,
+    /// Its welded adjacency (edge kinds, welded positions).
+    pub topo: crate::topology::Topology,
+    /// One h per edge of `topo`.
+    pub h: Vec<f64>,
+}
+
+/// The h of every welded edge of every mesh of `doc` (read from `asset`), resolved from the
+/// same sources and options as processing would: what the `h` picture draws.
+pub fn resolved_edges(
+    doc: &Document,
+    asset: &Path,
+    options: &Options,
+) -> Result<Vec<ResolvedEdges>, Error> {
+    let sharpness = asset_sharpness(doc, asset, options)?;
+    mesh_inputs(doc, asset)?
+        .iter()
+        .map(|m| {
+            let resolved = mesh_job::resolve(m, &sharpness, options, asset, &mut Vec::new())?;
+            Ok(ResolvedEdges {
+                mesh: m.mesh,
+                topo: resolved.topo,
+                h: resolved.params.h,
+            })
+        })
+        .collect()
+}
+
 /// The `extras` of `collection[index]` as plain JSON, if any.
 fn raw_extras(doc: &Document, collection: &[&str], index: usize) -> Option<Value> {
     let pointer = format!("/{}/{index}/extras", collection.join("/"));

@@ -1,0 +1,173 @@
+//! The z-buffer: which triangle is nearest at every pixel centre, and how near.
+//!
+//! Rasterizing only records the triangle and its depth; shading happens once per pixel
+//! afterwards ([`super::shade`]), so one raster serves every mode. The picture is cut into
+//! bands of rows that threads fill independently; each band takes its triangles in index order
+//! and keeps the first of equally near ones, so the result does not depend on the thread count.
+
+use rayon::prelude::*;
+
+use super::camera::Camera;
+use super::scene::Scene;
+
+/// Rows per band: small enough for two threads to share out evenly, large enough that few
+/// triangles straddle bands.
+const BAND_ROWS: usize = 16;
+
+/// No triangle covers the pixel.
+pub const EMPTY: u32 = u32::MAX;
+
+/// A rasterized picture.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    /// Side in pixels.
+    pub size: usize,
+    /// Every vertex projected: screen x, y, depth.
+    pub screen: Vec<[f32; 3]>,
+    /// Depth of the nearest surface per pixel, row-major (`f32::INFINITY` where empty).
+    pub depth: Vec<f32>,
+    /// The nearest triangle per pixel, or [`EMPTY`].
+    pub triangle: Vec<u32>,
+}
+
+/// Rasterizes `scene` through `camera`.
+pub fn rasterize(scene: &Scene, camera: &Camera) -> Frame {
+    let size = camera.size as usize;
+    let screen: Vec<[f32; 3]> = scene
+        .positions
+        .par_iter()
+        .map(|p| camera.project(*p))
+        .collect();
+    let bands = size.div_ceil(BAND_ROWS);
+    let binned = bin_by_band(&scene.triangles, &screen, size, bands);
+    let mut depth = vec![f32::INFINITY; size * size];
+    let mut triangle = vec![EMPTY; size * size];
+    let chunk = BAND_ROWS * size;
+    depth
+        .par_chunks_mut(chunk.max(1))
+        .zip(triangle.par_chunks_mut(chunk.max(1)))
+        .enumerate()
+        .for_each(|(band, (depth, tri))| {
+            let rows = band * BAND_ROWS..((band + 1) * BAND_ROWS).min(size);
+            for &t in binned.band(band) {
+                let [a, b, c] = scene.triangles[t as usize].map(|i| screen[i as usize]);
+                cover(a, b, c, size, rows.clone(), |x, y, z| {
+                    let at = (y - rows.start) * size + x;
+                    if z < depth[at] {
+                        depth[at] = z;
+                        tri[at] = t;
+                    }
+                });
+            }
+        });
+    Frame {
+        size,
+        screen,
+        depth,
+        triangle,
+    }
+}
+
+/// Triangle indices listed per band (a counting sort: linear in the triangles and bands
+/// they touch, and in index order within each band).
+struct Bins {
+    start: Vec<usize>,
+    items: Vec<u32>,
+}
+
+impl Bins {
+    fn band(&self, b: usize) -> &[u32] {
+        &self.items[self.start[b]..self.start[b + 1]]
+    }
+}
+
+fn bin_by_band(triangles: &[[u32; 3]], screen: &[[f32; 3]], size: usize, bands: usize) -> Bins {
+    // The bands each triangle's rows fall in; `None` off screen or not finite.
+    let spans: Vec<Option<(u32, u32)>> = triangles
+        .par_iter()
+        .map(|t| {
+            let ys = t.map(|i| screen[i as usize][1]);
+            let (lo, hi) = (ys[0].min(ys[1]).min(ys[2]), ys[0].max(ys[1]).max(ys[2]));
+            let rows = pixel_range(lo, hi, size)?;
+            Some(((rows.0 / BAND_ROWS) as u32, (rows.1 / BAND_ROWS) as u32))
+        })
+        .collect();
+    let mut start = vec![0usize; bands + 1];
+    for (b0, b1) in spans.iter().flatten() {
+        for b in *b0..=*b1 {
+            start[b as usize + 1] += 1;
+        }
+    }
+    for b in 0..bands {
+        start[b + 1] += start[b];
+    }
+    let mut fill = start.clone();
+    let mut items = vec![0u32; start[bands]];
+    for (t, span) in spans.iter().enumerate() {
+        if let Some((b0, b1)) = span {
+            for b in *b0..=*b1 {
+                items[fill[b as usize]] = t as u32;
+                fill[b as usize] += 1;
+            }
+        }
+    }
+    Bins { start, items }
+}
+
+/// The pixels whose centres (`k + 0.5`) lie in `lo..=hi`, clamped to the picture, as an
+/// inclusive range; `None` when there are none.
+#[inline]
+fn pixel_range(lo: f32, hi: f32, size: usize) -> Option<(usize, usize)> {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
+    let first = (lo - 0.5).ceil().max(0.0);
+    let last = (hi - 0.5).floor().min(size as f32 - 1.0);
+    (first <= last).then_some((first as usize, last as usize))
+}
+
+/// Calls `write(x, y, depth)` for every pixel centre in rows `rows` inside triangle `abc`
+/// (edges included; either winding; degenerate triangles cover nothing).
+#[inline]
+pub fn cover(
+    a: [f32; 3],
+    b: [f32; 3],
+    c: [f32; 3],
+    size: usize,
+    rows: std::ops::Range<usize>,
+    mut write: impl FnMut(usize, usize, f32),
+) {
+    let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    if area == 0.0 || !area.is_finite() {
+        return;
+    }
+    let Some((x0, x1)) = pixel_range(a[0].min(b[0]).min(c[0]), a[0].max(b[0]).max(c[0]), size)
+    else {
+        return;
+    };
+    let Some((y0, y1)) = pixel_range(a[1].min(b[1]).min(c[1]), a[1].max(b[1]).max(c[1]), size)
+    else {
+        return;
+    };
+    let (y0, y1) = (y0.max(rows.start), y1.min(rows.end.saturating_sub(1)));
+    let inv = 1.0 / area;
+    for y in y0..=y1 {
+        let py = y as f32 + 0.5;
+        for x in x0..=x1 {
+            let px = x as f32 + 0.5;
+            let [wa, wb, wc] = barycentric(a, b, c, px, py, inv);
+            if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
+                write(x, y, wa * a[2] + wb * b[2] + wc * c[2]);
+            }
+        }
+    }
+}
+
+/// Barycentric coordinates of screen point `(px, py)` in `abc`, given `inv` = 1 / the signed
+/// doubled area; all three are non-negative inside, whatever the winding.
+#[inline]
+pub fn barycentric(a: [f32; 3], b: [f32; 3], c: [f32; 3], px: f32, py: f32, inv: f32) -> [f32; 3] {
+    let wa = ((b[0] - px) * (c[1] - py) - (b[1] - py) * (c[0] - px)) * inv;
+    let wb = ((c[0] - px) * (a[1] - py) - (c[1] - py) * (a[0] - px)) * inv;
+    [wa, wb, 1.0 - wa - wb]
+}
