@@ -110,9 +110,14 @@ fn colour(n: Vec3, shading: Shading) -> Rgb {
                 [24, 24, 28]
             }
         }
-        Shading::Smooth | Shading::Flat => lit(n, [0.78, 0.80, 0.84], AMBIENT),
+        Shading::Smooth | Shading::Flat => shaded_colour(n),
         Shading::Pale => lit(n, [0.70, 0.70, 0.70], 0.45),
     }
+}
+
+/// The `shaded` and `flat` colour of a surface with unit normal `n` (camera frame).
+pub fn shaded_colour(n: Vec3) -> Rgb {
+    lit(n, [0.78, 0.80, 0.84], AMBIENT)
 }
 
 /// Lambert: `albedo` under the key light plus `ambient`.
