@@ -51,7 +51,7 @@ const STYLE: &str = "body{font:14px/1.4 system-ui,sans-serif;margin:1.5em;color:
 table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.2em .5em;text-align:right}\
 th{background:#f0f0f0}td.l,th.l{text-align:left}tr.failed td,tr.changed td{background:#fde8e8}\
 tr.cancelled td{color:#888}.status{font-weight:bold}.failed .status,.changed .status{color:#b00}\
-pre.error{background:#fde8e8;padding:.5em;white-space:pre-wrap}img{max-width:100%;image-rendering:pixelated;border:1px solid #ddd}\
+pre.error{background:#fde8e8;padding:.5em;white-space:pre-wrap}img{max-width:100%;border:1px solid #ddd}\
 section{margin-top:2em;border-top:2px solid #ddd}.swatch{display:inline-block;width:1em;height:1em;vertical-align:middle;margin:0 .3em 0 .8em}";
 
 fn page(run: &Run) -> String {
