@@ -101,14 +101,29 @@ fn the_html_report_opens_in_a_browser_with_every_picture_and_row() {
         .args(["--render-size", "64", "--render-views", "front,iso", "-q"])
         .output()
         .unwrap();
-    assert_eq!(out.status.code(), Some(1), "one input fails: {}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "one input fails: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let html = std::fs::read_to_string(&report).unwrap();
 
     // The page itself: escaped, self-contained, the failure with its location.
-    assert!(!html.contains(HOSTILE_NAME), "the mesh name went into the page as markup");
+    assert!(
+        !html.contains(HOSTILE_NAME),
+        "the mesh name went into the page as markup"
+    );
     assert!(html.contains("&lt;script&gt;document.title=&#39;owned&#39;&lt;/script&gt;"));
-    assert!(!html.contains("src=\"http") && !html.contains("src=\"file"), "the page refers to other files");
-    assert_eq!(html.matches("data:image/png;base64,").count(), 2, "one picture per processed input");
+    assert!(
+        !html.contains("src=\"http") && !html.contains("src=\"file"),
+        "the page refers to other files"
+    );
+    assert_eq!(
+        html.matches("data:image/png;base64,").count(),
+        2,
+        "one picture per processed input"
+    );
     let broken_row = html
         .lines()
         .find(|l| l.contains("<tr class=\"failed\">"))
@@ -118,30 +133,67 @@ fn the_html_report_opens_in_a_browser_with_every_picture_and_row() {
     let Some(browser) = chromium() else { return };
     // A copy with a script that writes what the browser made of the page into the DOM.
     let checked = dir.path().join("checked.html");
-    std::fs::write(&checked, html.replace("</body>", &format!("{CHECK_SCRIPT}</body>"))).unwrap();
-    let dom = browse(&browser, &checked, &["--virtual-time-budget=10000", "--dump-dom"]);
-    let start = dom.find("<pre id=\"check\">").expect("the check script ran") + "<pre id=\"check\">".len();
+    std::fs::write(
+        &checked,
+        html.replace("</body>", &format!("{CHECK_SCRIPT}</body>")),
+    )
+    .unwrap();
+    let dom = browse(
+        &browser,
+        &checked,
+        &["--virtual-time-budget=10000", "--dump-dom"],
+    );
+    let start = dom
+        .find("<pre id=\"check\">")
+        .expect("the check script ran")
+        + "<pre id=\"check\">".len();
     let end = start + dom[start..].find("</pre>").unwrap();
-    let text = dom[start..end].replace("&quot;", "\"").replace("&amp;", "&");
+    let text = dom[start..end]
+        .replace("&quot;", "\"")
+        .replace("&amp;", "&");
     let result: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(result["images"], 2, "{result}");
     assert_eq!(result["decoded"], 2, "a picture did not decode: {result}");
     assert_eq!(result["rows"], 3, "one table row per input: {result}");
     assert_eq!(result["failed_rows"], 1, "{result}");
-    assert_eq!(result["injected"], false, "markup from the asset became an element: {result}");
-    assert_eq!(result["title"], "g2tess report", "a script from the asset ran: {result}");
+    assert_eq!(
+        result["injected"], false,
+        "markup from the asset became an element: {result}"
+    );
+    assert_eq!(
+        result["title"], "g2tess report",
+        "a script from the asset ran: {result}"
+    );
 
     // The page as a person sees it: not blank.
     let shot = dir.path().join("shot.png");
-    browse(&browser, &report, &[&format!("--screenshot={}", shot.display()), "--window-size=1024,900"]);
+    browse(
+        &browser,
+        &report,
+        &[
+            &format!("--screenshot={}", shot.display()),
+            "--window-size=1024,900",
+        ],
+    );
     let decoder = png::Decoder::new(std::io::Cursor::new(std::fs::read(&shot).unwrap()));
     let mut reader = decoder.read_info().unwrap();
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
     let channels = info.color_type.samples();
     let pixels: Vec<&[u8]> = buf[..info.buffer_size()].chunks_exact(channels).collect();
-    let inked = pixels.iter().filter(|p| p[..3].iter().any(|&c| c < 200)).count();
+    let inked = pixels
+        .iter()
+        .filter(|p| p[..3].iter().any(|&c| c < 200))
+        .count();
     let colours: std::collections::HashSet<&[u8]> = pixels.iter().copied().collect();
-    assert!(inked * 50 > pixels.len(), "the screenshot is nearly blank: {inked} of {} pixels inked", pixels.len());
-    assert!(colours.len() > 50, "the screenshot has only {} colours", colours.len());
+    assert!(
+        inked * 50 > pixels.len(),
+        "the screenshot is nearly blank: {inked} of {} pixels inked",
+        pixels.len()
+    );
+    assert!(
+        colours.len() > 50,
+        "the screenshot has only {} colours",
+        colours.len()
+    );
 }
