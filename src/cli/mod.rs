@@ -246,6 +246,12 @@ fn render(args: &args::Args, layers: &args::Layers) -> i32 {
     let _ = rayon::ThreadPoolBuilder::new()
         .num_threads(args.jobs.unwrap_or(0))
         .build_global();
+    if let Some(dir) = args.inputs.iter().find(|i| i.is_dir()) {
+        return usage_error(&format!(
+            "{}: --render draws files (expected .gltf or .glb files, not a folder)",
+            dir.display()
+        ));
+    }
     let settings = args.picture_settings();
     match preview::render_command(&args.inputs, args.output.as_deref(), &options, &settings) {
         Ok(path) => {

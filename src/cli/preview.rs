@@ -16,11 +16,19 @@ use super::scope::Job;
 /// Draws `paths` side by side; the first one's edges make the `h` rows. The error names the
 /// file.
 pub fn draw(paths: &[&Path], options: &Options, settings: &Settings) -> Result<Vec<u8>, String> {
+    let (width, height) = render::sheet_size(paths.len(), settings);
+    if width.saturating_mul(height) > render::MAX_PIXELS {
+        return Err(format!(
+            "{}: the picture would be {width} × {height} pixels (expected at most {} million: a smaller --render-size, or fewer views, modes or files)",
+            paths.first().map_or(String::new(), |p| p.display().to_string()),
+            render::MAX_PIXELS / 1_000_000,
+        ));
+    }
     let mut scenes = Vec::with_capacity(paths.len());
     let mut edges = None;
     for (k, path) in paths.iter().enumerate() {
         let doc = gltf_io::read(path, &options.read_options()).map_err(|e| e.to_string())?;
-        let scene = Scene::from_document(&doc).map_err(|e| e.to_string())?;
+        let scene = Scene::from_document(&doc).map_err(|e| format!("{}: {e}", path.display()))?;
         if k == 0 && settings.modes.contains(&render::Mode::H) {
             edges = Some(edge_h(&doc, path, options)?);
         }
@@ -52,20 +60,14 @@ fn edge_h(
         .collect())
 }
 
-/// `--render`: draws `inputs` into `output` (default: the first input with `.png`); returns
-/// the exit status's message on failure.
+/// `--render`: draws `inputs` (files) into `output` (default: the first input with `.png`);
+/// the error is a message naming the file.
 pub fn render_command(
     inputs: &[PathBuf],
     output: Option<&Path>,
     options: &Options,
     settings: &Settings,
 ) -> Result<PathBuf, String> {
-    if let Some(dir) = inputs.iter().find(|i| i.is_dir()) {
-        return Err(format!(
-            "{}: --render draws files (expected .gltf or .glb files, not a folder)",
-            dir.display()
-        ));
-    }
     let target = match output {
         Some(o) => o.to_path_buf(),
         None => inputs[0].with_extension("png"),

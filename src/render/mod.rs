@@ -7,7 +7,7 @@
 //! - [`raster`]: the z-buffer (nearest triangle and depth per pixel), in parallel bands.
 //! - [`shade`]: per-pixel colour of each [`Mode`] but `h`.
 //! - [`edges`]: the `h` picture's edges, coloured by their resolved h.
-//! - [`sheet`]: several documents side by side, one row per mode, one group per view, and PNG.
+//! - [`mod@sheet`]: several documents side by side, one row per mode, one group per view, and PNG.
 //!
 //! Pictures are byte-identical at any thread count: each band of rows is filled by one thread
 //! in triangle order, and shading reads only its own pixel.
@@ -22,4 +22,4 @@ pub mod sheet;
 pub use camera::{Camera, View};
 pub use edges::{EdgeClass, MeshEdges};
 pub use scene::Scene;
-pub use sheet::{sheet, Image, Mode, Settings, Subject};
+pub use sheet::{sheet, sheet_size, Image, Mode, Settings, Subject, MAX_PIXELS};

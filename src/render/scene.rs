@@ -25,9 +25,10 @@ pub struct Scene {
     pub instances: Vec<(usize, Mat4)>,
 }
 
-/// Nodes nested deeper than this are not drawn (the reader refuses cycles; this bounds the
-/// walk of any tree it accepts).
-const MAX_DEPTH: usize = 256;
+/// Most triangles a scene may place (every instance counted): about 50 bytes each while
+/// drawing, so a file that places one large mesh at thousands of nodes is refused rather than
+/// exhausting memory.
+pub const MAX_TRIANGLES: u64 = 40_000_000;
 
 impl Scene {
     /// Collects the default scene of `doc` (the first scene when none is named as default,
@@ -56,17 +57,17 @@ impl Scene {
                 (0..root.nodes.len()).filter(|&i| !child[i]).collect()
             }
         };
+        // glTF's nodes form trees (the reader refuses a node with two parents); each node is
+        // still walked at most once, so the walk stays linear in the nodes.
+        let mut walked = vec![false; root.nodes.len()];
         let mut instances = Vec::new();
-        let mut stack: Vec<(usize, Mat4, usize)> = roots
-            .iter()
-            .rev()
-            .map(|&n| (n, Mat4::IDENTITY, 0))
-            .collect();
-        while let Some((n, parent, depth)) = stack.pop() {
+        let mut stack: Vec<(usize, Mat4)> =
+            roots.iter().rev().map(|&n| (n, Mat4::IDENTITY)).collect();
+        while let Some((n, parent)) = stack.pop() {
             let Some(node) = root.nodes.get(n) else {
                 continue;
             };
-            if depth > MAX_DEPTH {
+            if std::mem::replace(&mut walked[n], true) {
                 continue;
             }
             let world = parent * local_transform(node);
@@ -74,7 +75,7 @@ impl Scene {
                 instances.push((mesh.value(), world));
             }
             for c in node.children.iter().flatten().rev() {
-                stack.push((c.value(), world, depth + 1));
+                stack.push((c.value(), world));
             }
         }
         let mut scene = Scene {
@@ -82,6 +83,21 @@ impl Scene {
             ..Scene::default()
         };
         let used: BTreeSet<usize> = scene.instances.iter().map(|(m, _)| *m).collect();
+        let mut per_mesh: BTreeMap<usize, u64> = BTreeMap::new();
+        for (mesh, prim) in doc.triangle_primitives() {
+            *per_mesh.entry(mesh).or_default() += doc.primitive_size(mesh, prim).triangles;
+        }
+        let placed = scene
+            .instances
+            .iter()
+            .map(|(m, _)| per_mesh.get(m).copied().unwrap_or(0))
+            .fold(0u64, u64::saturating_add);
+        if placed > MAX_TRIANGLES {
+            return Err(gltf_io::Error::invalid(
+                "scene",
+                format!("places {placed} triangles to draw (expected at most {MAX_TRIANGLES})"),
+            ));
+        }
         let mut decoded: BTreeMap<usize, Vec<Local>> = BTreeMap::new();
         for (mesh, prim) in doc.triangle_primitives() {
             if used.contains(&mesh) {

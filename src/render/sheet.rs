@@ -102,16 +102,29 @@ impl Image {
     }
 }
 
+/// Most pixels in one picture (3 bytes each): enough for four views of two files in three
+/// modes at 1 600 pixels.
+pub const MAX_PIXELS: usize = 1 << 27;
+
+/// Width and height of the picture of `subjects` documents under `settings`.
+pub fn sheet_size(subjects: usize, settings: &Settings) -> (usize, usize) {
+    let size = settings.size.max(1) as usize;
+    let n = subjects.max(1);
+    let group = n * size + (n - 1) * GAP;
+    let views = settings.views.len().max(1);
+    let rows = settings.modes.len().max(1);
+    (
+        views * group + (views - 1) * VIEW_GAP,
+        rows * size + (rows - 1) * GAP,
+    )
+}
+
 /// Draws `subjects` side by side: for each view, one column per subject (all framed on the
 /// union of their bounds, so they line up), and one row per mode.
 pub fn sheet(subjects: &[Subject], settings: &Settings) -> Image {
     let size = settings.size.max(1) as usize;
-    let n = subjects.len().max(1);
-    let group = n * size + (n - 1) * GAP;
-    let views = settings.views.len().max(1);
-    let width = views * group + (views - 1) * VIEW_GAP;
-    let rows = settings.modes.len().max(1);
-    let height = rows * size + (rows - 1) * GAP;
+    let group = subjects.len().max(1) * (size + GAP) - GAP;
+    let (width, height) = sheet_size(subjects.len(), settings);
     let mut image = Image::new(width, height);
     let points = || {
         let all: Vec<&[glam::Vec3]> = subjects
