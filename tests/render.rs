@@ -482,3 +482,132 @@ fn quantized_and_compressed_outputs_draw_like_plain_ones() {
         "{far} pixels differ by more than 6 levels"
     );
 }
+
+/// Pixels of each colour in `img`.
+fn colour_counts(img: &Image) -> HashMap<[u8; 3], usize> {
+    let mut counts = HashMap::new();
+    for p in &img.pixels {
+        *counts.entry(*p).or_insert(0) += 1;
+    }
+    counts
+}
+
+/// The `h` picture of a one-mesh asset under `options`, front view.
+fn h_picture(gltf: &str, options: &g2tess::options::Options) -> Image {
+    let doc = g2tess::gltf_io::read_bytes(gltf.as_bytes(), None, &Default::default()).unwrap();
+    let scene = Scene::from_document(&doc).unwrap();
+    let asset = std::path::Path::new("memory.gltf");
+    let edges: Vec<g2tess::render::MeshEdges> =
+        g2tess::pipeline::resolved_edges(&doc, asset, options)
+            .unwrap()
+            .iter()
+            .map(|r| g2tess::render::MeshEdges::from_topology(r.mesh, &r.topo, &r.h))
+            .collect();
+    let settings = Settings {
+        modes: vec![Mode::H],
+        views: vec![View::Iso],
+        size: 160,
+    };
+    sheet(
+        &[Subject {
+            scene: &scene,
+            edges: Some(&edges),
+        }],
+        &settings,
+    )
+}
+
+#[test]
+fn the_h_picture_colours_creases_blended_and_open_edges_apart() {
+    use g2tess::render::EdgeClass;
+    let octahedron = gltf_build::gltf("octahedron", None, &[gltf_build::octahedron()]);
+    let crease = EdgeClass::Crease.colour();
+    let blended = EdgeClass::Blended(0.212).colour();
+    let open = EdgeClass::Open.colour();
+    // Neighbouring normals of the octahedron meet at 70.5°: creases under a 60° crease angle,
+    // blended under 90°.
+    let mut options = g2tess::options::Options::default();
+    options.crease_angle = 60.0;
+    let sharp = colour_counts(&h_picture(&octahedron, &options));
+    options.crease_angle = 90.0;
+    let smooth = colour_counts(&h_picture(&octahedron, &options));
+    let count = |c: &HashMap<[u8; 3], usize>, k| c.get(&k).copied().unwrap_or(0);
+    assert!(
+        count(&sharp, crease) > 100 && count(&sharp, blended) == 0,
+        "60°: {sharp:?}"
+    );
+    assert!(
+        count(&smooth, blended) > 100 && count(&smooth, crease) == 0,
+        "90°: {smooth:?}"
+    );
+    assert_eq!(
+        count(&sharp, open) + count(&smooth, open),
+        0,
+        "a closed mesh has no open edge"
+    );
+    // Half of it (the four triangles with z >= 0) is open along its equator.
+    let mut half = gltf_build::octahedron();
+    half.indices.truncate(12);
+    let open_mesh = colour_counts(&h_picture(
+        &gltf_build::gltf("half", None, &[half]),
+        &options,
+    ));
+    assert!(count(&open_mesh, open) > 50, "{open_mesh:?}");
+}
+
+#[test]
+fn previews_are_written_per_asset_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = dir.path().join("in");
+    std::fs::create_dir_all(inputs.join("props")).unwrap();
+    let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/icosahedron.glb");
+    std::fs::copy(&fixture, inputs.join("props/ico.glb")).unwrap();
+    std::fs::copy(&fixture, inputs.join("ico.glb")).unwrap();
+    let bin = env!("CARGO_BIN_EXE_g2tess");
+    let out = dir.path().join("out");
+    let plain = std::process::Command::new(bin)
+        .arg(&inputs)
+        .arg("-o")
+        .arg(&out)
+        .arg("-q")
+        .status()
+        .unwrap();
+    assert!(plain.success());
+    let pngs = walk_pngs(dir.path());
+    assert!(pngs.is_empty(), "a run without previews drew {pngs:?}");
+    let previews = dir.path().join("previews");
+    let run = std::process::Command::new(bin)
+        .arg(&inputs)
+        .arg("-o")
+        .arg(&out)
+        .arg("--previews")
+        .arg(&previews)
+        .args(["--render-size", "40", "--render-modes", "shaded,h", "-q"])
+        .status()
+        .unwrap();
+    assert!(run.success());
+    let settings = Settings {
+        modes: vec![Mode::Shaded, Mode::H],
+        views: View::ALL.to_vec(),
+        size: 40,
+    };
+    let (width, height) = g2tess::render::sheet_size(2, &settings);
+    for name in ["ico.glb.png", "props/ico.glb.png"] {
+        let img = decode_png(&std::fs::read(previews.join(name)).unwrap());
+        assert_eq!((img.width, img.height), (width, height), "{name}");
+    }
+    assert_eq!(walk_pngs(&previews).len(), 2);
+}
+
+fn walk_pngs(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            found.extend(walk_pngs(&path));
+        } else if path.extension().is_some_and(|e| e == "png") {
+            found.push(path);
+        }
+    }
+    found
+}
