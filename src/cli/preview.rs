@@ -74,6 +74,15 @@ pub fn render_command(
     };
     let paths: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     let png = draw(&paths, options, settings)?;
+    if let Some(dir) = target.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            format!(
+                "{}: cannot create the output folder: {}",
+                dir.display(),
+                e.to_string().to_lowercase()
+            )
+        })?;
+    }
     gltf_io::write::atomic_write(&target, &png).map_err(|e| e.to_string())?;
     Ok(target)
 }
