@@ -153,7 +153,12 @@ pub fn cover(
     let inv = 1.0 / area;
     for y in y0..=y1 {
         let py = y as f32 + 0.5;
-        for x in x0..=x1 {
+        // Only the row's span inside the triangle is visited (a long sliver costs its rows
+        // and pixels, not its bounding box); the exact test below still decides each pixel.
+        let Some((first, last)) = row_span(a, b, c, py, inv, x0, x1) else {
+            continue;
+        };
+        for x in first..=last {
             let px = x as f32 + 0.5;
             let [wa, wb, wc] = barycentric(a, b, c, px, py, inv);
             if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
@@ -163,6 +168,46 @@ pub fn cover(
     }
 }
 
+/// The pixels of row `py` that may lie inside `abc`, within `x0..=x1`: each barycentric
+/// coordinate is linear along the row, so the inside is an interval; it is widened by
+/// [`SPAN_SLACK`] pixels so that rounding never drops a pixel the exact test accepts.
+#[inline]
+fn row_span(
+    a: [f32; 3],
+    b: [f32; 3],
+    c: [f32; 3],
+    py: f32,
+    inv: f32,
+    x0: usize,
+    x1: usize,
+) -> Option<(usize, usize)> {
+    // w = k + s·px for each coordinate (see `barycentric`).
+    let (sa, ka) = (
+        (b[1] - c[1]) * inv,
+        (b[0] * (c[1] - py) - (b[1] - py) * c[0]) * inv,
+    );
+    let (sb, kb) = (
+        (c[1] - a[1]) * inv,
+        (c[0] * (a[1] - py) - (c[1] - py) * a[0]) * inv,
+    );
+    let (sc, kc) = (-(sa + sb), 1.0 - ka - kb);
+    let (mut lo, mut hi) = (x0 as f32, x1 as f32 + 1.0);
+    for (s, k) in [(sa, ka), (sb, kb), (sc, kc)] {
+        let root = -k / s;
+        if s > 0.0 && root.is_finite() {
+            lo = lo.max(root);
+        } else if s < 0.0 && root.is_finite() {
+            hi = hi.min(root);
+        }
+    }
+    let first = ((lo - 0.5).ceil() - SPAN_SLACK).max(x0 as f32);
+    let last = ((hi - 0.5).floor() + SPAN_SLACK).min(x1 as f32);
+    (first <= last).then_some((first as usize, last as usize))
+}
+
+/// Pixels added on each side of a row's computed span.
+const SPAN_SLACK: f32 = 2.0;
+
 /// Barycentric coordinates of screen point `(px, py)` in `abc`, given `inv` = 1 / the signed
 /// doubled area; all three are non-negative inside, whatever the winding.
 #[inline]
@@ -170,4 +215,57 @@ pub fn barycentric(a: [f32; 3], b: [f32; 3], c: [f32; 3], px: f32, py: f32, inv:
     let wa = ((b[0] - px) * (c[1] - py) - (b[1] - py) * (c[0] - px)) * inv;
     let wb = ((c[0] - px) * (a[1] - py) - (c[1] - py) * (a[0] - px)) * inv;
     [wa, wb, 1.0 - wa - wb]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every pixel centre of a `size`² picture inside `abc` by the exact test alone.
+    fn brute_force(a: [f32; 3], b: [f32; 3], c: [f32; 3], size: usize) -> Vec<(usize, usize)> {
+        let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        let mut out = Vec::new();
+        if area == 0.0 {
+            return out;
+        }
+        for y in 0..size {
+            for x in 0..size {
+                let w = barycentric(a, b, c, x as f32 + 0.5, y as f32 + 0.5, 1.0 / area);
+                if w.iter().all(|&v| v >= 0.0) {
+                    out.push((x, y));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn row_spans_cover_exactly_the_pixels_of_the_exact_test() {
+        let size = 48;
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 64.0 - 8.0
+        };
+        for k in 0..3000 {
+            let mut v = [[0.0f32; 3]; 3];
+            for p in &mut v {
+                *p = [next(), next(), 0.0];
+            }
+            if k % 3 == 0 {
+                // A sliver: the third corner close to the first edge.
+                v[2] = [
+                    v[0][0] + (v[1][0] - v[0][0]) * 0.5,
+                    v[0][1] + (v[1][1] - v[0][1]) * 0.5 + 0.01,
+                    0.0,
+                ];
+            }
+            let mut got = Vec::new();
+            cover(v[0], v[1], v[2], size, 0..size, |x, y, _| got.push((x, y)));
+            got.sort_unstable_by_key(|&(x, y)| (y, x));
+            assert_eq!(got, brute_force(v[0], v[1], v[2], size), "triangle {v:?}");
+        }
+    }
 }
