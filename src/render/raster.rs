@@ -49,7 +49,7 @@ pub fn rasterize(scene: &Scene, camera: &Camera) -> Frame {
         .enumerate()
         .for_each(|(band, (depth, tri))| {
             let rows = band * BAND_ROWS..((band + 1) * BAND_ROWS).min(size);
-            for &t in binned.band(band) {
+            binned.for_each(band, |t| {
                 let [a, b, c] = scene.triangles[t as usize].map(|i| screen[i as usize]);
                 cover(a, b, c, size, rows.clone(), |x, y, z| {
                     let at = (y - rows.start) * size + x;
@@ -58,7 +58,7 @@ pub fn rasterize(scene: &Scene, camera: &Camera) -> Frame {
                         tri[at] = t;
                     }
                 });
-            }
+            });
         });
     Frame {
         size,
@@ -68,21 +68,38 @@ pub fn rasterize(scene: &Scene, camera: &Camera) -> Frame {
     }
 }
 
-/// Triangle indices listed per band (a counting sort: linear in the triangles and bands
-/// they touch, and in index order within each band).
+/// Triangles per band, in index order within each band: listed (a counting sort, linear in
+/// the triangles and the bands they touch) unless that list would exceed
+/// [`LISTED_PER_TRIANGLE`] entries per triangle (long slivers across the picture), in which
+/// case each band scans every triangle's rows instead, so memory stays linear in the triangles.
 struct Bins {
-    start: Vec<usize>,
-    items: Vec<u32>,
+    /// The bands of each triangle; `None` off screen or not finite.
+    spans: Vec<Option<(u32, u32)>>,
+    /// Where each band's list starts in `items`, and the lists (when listed).
+    listed: Option<(Vec<usize>, Vec<u32>)>,
 }
 
+/// The most band entries per triangle that are listed.
+const LISTED_PER_TRIANGLE: usize = 4;
+
 impl Bins {
-    fn band(&self, b: usize) -> &[u32] {
-        &self.items[self.start[b]..self.start[b + 1]]
+    /// Calls `f` with every triangle touching band `b`, in index order.
+    fn for_each(&self, b: usize, mut f: impl FnMut(u32)) {
+        match &self.listed {
+            Some((start, items)) => items[start[b]..start[b + 1]].iter().for_each(|&t| f(t)),
+            None => {
+                let b = b as u32;
+                for (t, span) in self.spans.iter().enumerate() {
+                    if span.is_some_and(|(b0, b1)| b0 <= b && b <= b1) {
+                        f(t as u32);
+                    }
+                }
+            }
+        }
     }
 }
 
 fn bin_by_band(triangles: &[[u32; 3]], screen: &[[f32; 3]], size: usize, bands: usize) -> Bins {
-    // The bands each triangle's rows fall in; `None` off screen or not finite.
     let spans: Vec<Option<(u32, u32)>> = triangles
         .par_iter()
         .map(|t| {
@@ -92,14 +109,24 @@ fn bin_by_band(triangles: &[[u32; 3]], screen: &[[f32; 3]], size: usize, bands: 
             Some(((rows.0 / BAND_ROWS) as u32, (rows.1 / BAND_ROWS) as u32))
         })
         .collect();
-    let mut start = vec![0usize; bands + 1];
+    // Entries per band by a difference array: linear in triangles plus bands.
+    let mut start = vec![0i64; bands + 2];
     for (b0, b1) in spans.iter().flatten() {
-        for b in *b0..=*b1 {
-            start[b as usize + 1] += 1;
-        }
+        start[*b0 as usize + 1] += 1;
+        start[*b1 as usize + 2] -= 1;
     }
+    for b in 1..start.len() {
+        start[b] += start[b - 1];
+    }
+    let mut start: Vec<usize> = start[..=bands].iter().map(|&n| n as usize).collect();
     for b in 0..bands {
         start[b + 1] += start[b];
+    }
+    if start[bands] > LISTED_PER_TRIANGLE * triangles.len() + bands {
+        return Bins {
+            spans,
+            listed: None,
+        };
     }
     let mut fill = start.clone();
     let mut items = vec![0u32; start[bands]];
@@ -111,7 +138,10 @@ fn bin_by_band(triangles: &[[u32; 3]], screen: &[[f32; 3]], size: usize, bands: 
             }
         }
     }
-    Bins { start, items }
+    Bins {
+        spans,
+        listed: Some((start, items)),
+    }
 }
 
 /// The pixels whose centres (`k + 0.5`) lie in `lo..=hi`, clamped to the picture, as an
@@ -267,5 +297,75 @@ mod tests {
             got.sort_unstable_by_key(|&(x, y)| (y, x));
             assert_eq!(got, brute_force(v[0], v[1], v[2], size), "triangle {v:?}");
         }
+    }
+
+    /// The frame of `scene` drawn in one pass over whole pictures, triangle by triangle.
+    fn one_pass(scene: &Scene, camera: &Camera) -> (Vec<f32>, Vec<u32>) {
+        let size = camera.size as usize;
+        let screen: Vec<[f32; 3]> = scene.positions.iter().map(|p| camera.project(*p)).collect();
+        let (mut depth, mut tri) = (vec![f32::INFINITY; size * size], vec![EMPTY; size * size]);
+        for (t, corners) in scene.triangles.iter().enumerate() {
+            let [a, b, c] = corners.map(|i| screen[i as usize]);
+            cover(a, b, c, size, 0..size, |x, y, z| {
+                if z < depth[y * size + x] {
+                    depth[y * size + x] = z;
+                    tri[y * size + x] = t as u32;
+                }
+            });
+        }
+        (depth, tri)
+    }
+
+    #[test]
+    fn bands_listed_or_scanned_draw_what_one_pass_draws() {
+        use glam::{Mat4, Vec3};
+        // Slivers from the top of the picture to the bottom, tilted in depth, crossing each
+        // other: each touches every band, so the bands scan instead of listing.
+        let mut scene = Scene::default();
+        for k in 0..40u32 {
+            let x = k as f32 / 40.0 * 2.0 - 1.0;
+            let z = (k % 7) as f32 * 0.1;
+            scene.positions.extend([
+                Vec3::new(x, -1.0, z),
+                Vec3::new(x + 0.3, 1.0, -z),
+                Vec3::new(x + 0.05, -1.0, 0.5 - z),
+            ]);
+            scene.triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
+        }
+        scene.normals = vec![Vec3::Z; scene.positions.len()];
+        scene.instances = vec![(0, Mat4::IDENTITY)];
+        let camera = Camera::framing(
+            || vec![scene.positions.as_slice()].into_par_iter().flatten(),
+            super::super::View::Front,
+            96,
+        );
+        let frame = rasterize(&scene, &camera);
+        let screen: Vec<[f32; 3]> = scene.positions.iter().map(|p| camera.project(*p)).collect();
+        let bands = 96usize.div_ceil(BAND_ROWS);
+        assert!(bin_by_band(&scene.triangles, &screen, 96, bands)
+            .listed
+            .is_none());
+        let (depth, tri) = one_pass(&scene, &camera);
+        assert!(tri.iter().filter(|&&t| t != EMPTY).count() > 1000);
+        assert_eq!(frame.triangle, tri);
+        assert_eq!(frame.depth, depth);
+        // Small triangles only: listed, and the same again.
+        let mut small = scene.clone();
+        small.triangles.clear();
+        for k in 0..40u32 {
+            let p = scene.positions[3 * k as usize];
+            small.positions.push(p + Vec3::new(0.02, 0.3, 0.0));
+            small
+                .triangles
+                .push([3 * k, 3 * k + 2, small.positions.len() as u32 - 1]);
+        }
+        small.normals = vec![Vec3::Z; small.positions.len()];
+        let screen: Vec<[f32; 3]> = small.positions.iter().map(|p| camera.project(*p)).collect();
+        assert!(bin_by_band(&small.triangles, &screen, 96, bands)
+            .listed
+            .is_some());
+        let frame = rasterize(&small, &camera);
+        assert!(frame.triangle.iter().filter(|&&t| t != EMPTY).count() > 200);
+        assert_eq!((frame.depth, frame.triangle), one_pass(&small, &camera));
     }
 }
