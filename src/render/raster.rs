@@ -185,7 +185,12 @@ pub fn cover(
         let py = y as f32 + 0.5;
         // Only the row's span inside the triangle is visited (a long sliver costs its rows
         // and pixels, not its bounding box); the exact test below still decides each pixel.
-        let Some((first, last)) = row_span(a, b, c, py, inv, x0, x1) else {
+        let span = match x1 - x0 {
+            // A few pixels wide: testing them is cheaper than finding the span.
+            0..=3 => Some((x0, x1)),
+            _ => row_span(a, b, c, py, inv, x0, x1),
+        };
+        let Some((first, last)) = span else {
             continue;
         };
         for x in first..=last {
