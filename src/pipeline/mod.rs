@@ -236,8 +236,9 @@ pub fn resolved_edges(
     options: &Options,
 ) -> Result<Vec<ResolvedEdges>, Error> {
     let sharpness = asset_sharpness(doc, asset, options)?;
+    // Meshes are independent, as in processing: resolved in parallel, collected in file order.
     mesh_inputs(doc, asset)?
-        .iter()
+        .par_iter()
         .map(|m| {
             let resolved = mesh_job::resolve(m, &sharpness, options, asset, &mut Vec::new())?;
             Ok(ResolvedEdges {
