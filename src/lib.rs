@@ -28,6 +28,8 @@
 //! - [`optimize`]: meshoptimizer's vertex cache and fetch ordering.
 //! - [`options`]: the resolved settings that flow down through every stage.
 //! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages.
+//! - [`render`]: pictures of any document on the CPU (shaded, zebra, flat, and the input's
+//!   edges coloured by h), side by side with one camera, as PNG.
 //! - [`huge_pages`]: the binary's allocator, which asks Linux for transparent huge pages on
 //!   large buffers (fewer page faults when a dense mesh fills hundreds of MiB).
 //!
@@ -48,6 +50,7 @@ pub mod normals;
 pub mod optimize;
 pub mod options;
 pub mod pipeline;
+pub mod render;
 pub mod sharpness;
 pub mod surface;
 pub mod tangents;

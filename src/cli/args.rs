@@ -198,7 +198,50 @@ pub struct Args {
     /// merged exit status
     #[arg(long, value_name = "FILE", help_heading = "Build systems")]
     pub merge_reports: Option<PathBuf>,
+    /// Draw the INPUTs side by side (one camera, same scale) into the PNG -o names, and exit
+    /// without processing [default: the first INPUT's name with .png]
+    #[arg(long, help_heading = "Pictures", conflicts_with_all = ["watch", "check", "explain_h"])]
+    pub render: bool,
+
+    /// Write a PNG per processed asset into DIR (named after its output, with .png added):
+    /// input and output side by side
+    #[arg(long, value_name = "DIR", help_heading = "Pictures")]
+    pub previews: Option<PathBuf>,
+
+    /// Write an HTML report to FILE: a table of every input (status, triangles, sizes, times,
+    /// warnings, errors) and per asset its pictures (embedded) and continuity figures
+    #[arg(long, value_name = "FILE", help_heading = "Pictures")]
+    pub html_report: Option<PathBuf>,
+
+    /// Picture rows, comma-separated: shaded (the normals lit), zebra (reflection lines),
+    /// flat (the triangles), h (the input's edges: blue blended, darker for larger h; red
+    /// crease; orange open; magenta non-manifold) [default: shaded,zebra,h]
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        value_name = "MODES",
+        help_heading = "Pictures"
+    )]
+    pub render_modes: Vec<RenderModeArg>,
+
+    /// Picture views, comma-separated: front, side, top, iso [default: front,side,top,iso]
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        value_name = "VIEWS",
+        help_heading = "Pictures"
+    )]
+    pub render_views: Vec<RenderViewArg>,
+
+    /// Side of each picture panel in pixels, 16 to 4096 [default: 320]
+    #[arg(long, value_name = "PX", help_heading = "Pictures", value_parser = clap::value_parser!(u32).range(16..=4096))]
+    pub render_size: Option<u32>,
 }
+
+/// Default of `--render-size`: four views of input and output fit a wide screen.
+const DEFAULT_RENDER_SIZE: u32 = 320;
 
 const EXIT_HELP: &str = "Exit status: 0 every input done (or up to date), 1 some input failed or, with --check, some output is not current (the others were still processed), 2 usage or configuration error, 130 stopped by Ctrl-C before the end (the files in flight were finished; --watch ends with 0).";
 
@@ -242,7 +285,69 @@ pub enum SchemeArg {
     Coons,
 }
 
+/// `--render-modes` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RenderModeArg {
+    /// Lambert with the mesh's normals
+    Shaded,
+    /// Reflection-line stripes
+    Zebra,
+    /// Lambert with face normals
+    Flat,
+    /// The first input's edges coloured by resolved h
+    H,
+}
+
+/// `--render-views` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RenderViewArg {
+    /// From +Z
+    Front,
+    /// From +X
+    Side,
+    /// From +Y
+    Top,
+    /// From (1, 1, 1)
+    Iso,
+}
+
 impl Args {
+    /// The picture settings of `--render-modes`, `--render-views` and `--render-size`.
+    pub fn picture_settings(&self) -> g2tess::render::Settings {
+        use g2tess::render::{Mode, View};
+        let modes = match self.render_modes.is_empty() {
+            true => vec![Mode::Shaded, Mode::Zebra, Mode::H],
+            false => self
+                .render_modes
+                .iter()
+                .map(|m| match m {
+                    RenderModeArg::Shaded => Mode::Shaded,
+                    RenderModeArg::Zebra => Mode::Zebra,
+                    RenderModeArg::Flat => Mode::Flat,
+                    RenderModeArg::H => Mode::H,
+                })
+                .collect(),
+        };
+        let views = match self.render_views.is_empty() {
+            true => View::ALL.to_vec(),
+            false => self
+                .render_views
+                .iter()
+                .map(|v| match v {
+                    RenderViewArg::Front => View::Front,
+                    RenderViewArg::Side => View::Side,
+                    RenderViewArg::Top => View::Top,
+                    RenderViewArg::Iso => View::Iso,
+                })
+                .collect(),
+        };
+        g2tess::render::Settings {
+            modes,
+            views,
+            size: self.render_size.unwrap_or(DEFAULT_RENDER_SIZE),
+        }
+    }
+
     /// The settings in their layers, so that a folder's `g2tess.toml` can slot in between the
     /// `--config` file and the flags.
     pub fn layers(&self) -> Result<Layers, ConfigError> {
@@ -261,7 +366,7 @@ impl Args {
             base,
             flags: self.flag_settings(),
             sidecar: self.sidecar.clone(),
-            report_figures: self.report.is_some(),
+            report_figures: self.report.is_some() || self.html_report.is_some(),
         };
         layers.resolve(None)?;
         Ok(layers)

@@ -13,9 +13,11 @@ mod collisions;
 mod declared_inputs;
 mod depfile;
 mod dir_config;
+mod html_report;
 mod interrupt;
 mod manifest;
 mod merge_reports;
+mod preview;
 mod progress;
 mod report;
 mod scope;
@@ -71,6 +73,9 @@ pub fn run() -> i32 {
     }
     if let Some(mesh) = &args.explain_h {
         return explain_h(&args.inputs, &layers, mesh);
+    }
+    if args.render {
+        return render(&args, &layers);
     }
     let scope = match Scope::new(
         &args.inputs,
@@ -145,6 +150,9 @@ pub fn run() -> i32 {
         report: args.report.clone(),
         depfile: args.depfile,
         config: args.config.clone(),
+        previews: args.previews.clone(),
+        html_report: args.html_report.clone(),
+        picture_settings: args.picture_settings(),
         summary_always: args.inputs.len() > 1 || args.inputs.iter().any(|i| i.is_dir()),
         status: std::cell::Cell::new(EXIT_OK),
     };
@@ -180,6 +188,12 @@ pub struct Runner<'a> {
     depfile: bool,
     /// `--config`, which every asset's run reads.
     config: Option<PathBuf>,
+    /// `--previews DIR`.
+    previews: Option<PathBuf>,
+    /// `--html-report FILE`.
+    html_report: Option<PathBuf>,
+    /// What previews and the HTML report draw.
+    picture_settings: g2tess::render::Settings,
     /// Print the summary line even for a single file.
     summary_always: bool,
     /// The exit status of the last round.
@@ -238,8 +252,47 @@ impl Runner<'_> {
                 status = status.max(EXIT_SOME_FAILED);
             }
         }
+        if self.previews.is_some() || self.html_report.is_some() {
+            status = status.max(self.pictures(jobs, &options, &outcomes, &summary, status));
+        }
         self.status.set(status);
         outcomes
+    }
+
+    /// Draws the previews and writes them and the HTML report; returns the exit status their
+    /// failures call for.
+    fn pictures(
+        &self,
+        jobs: &[Job],
+        options: &[Result<g2tess::options::Options, String>],
+        outcomes: &[Outcome],
+        summary: &Summary,
+        status: i32,
+    ) -> i32 {
+        let pictures = preview::pictures(jobs, options, outcomes, &self.picture_settings);
+        let mut errors = Vec::new();
+        if let Some(dir) = &self.previews {
+            errors.extend(preview::write_previews(dir, jobs, &pictures));
+        }
+        if let Some(file) = &self.html_report {
+            let run = html_report::Run {
+                jobs,
+                outcomes,
+                summary,
+                check: self.settings.check,
+                exit_status: status,
+                pictures: &pictures,
+                settings: &self.picture_settings,
+            };
+            errors.extend(html_report::write(file, &run).err());
+        }
+        for e in &errors {
+            eprintln!("g2tess: error: {e}");
+        }
+        match errors.is_empty() {
+            true => EXIT_OK,
+            false => EXIT_SOME_FAILED,
+        }
     }
 
     /// Saves the manifests (never with `--check`); a failure only costs the next run its skips.
@@ -251,6 +304,36 @@ impl Runner<'_> {
             say(&format!(
                 "g2tess: warning: {e}: the next run will process every file again"
             ));
+        }
+    }
+}
+
+/// `--render`: draws the inputs side by side into one PNG; processes nothing.
+fn render(args: &args::Args, layers: &args::Layers) -> i32 {
+    let options = match layers.resolve(None) {
+        Ok(o) => o,
+        Err(e) => return usage_error(&e.to_string()),
+    };
+    let _ = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs.unwrap_or(0))
+        .build_global();
+    if let Some(dir) = args.inputs.iter().find(|i| i.is_dir()) {
+        return usage_error(&format!(
+            "{}: --render draws files (expected .gltf or .glb files, not a folder)",
+            dir.display()
+        ));
+    }
+    let settings = args.picture_settings();
+    match preview::render_command(&args.inputs, args.output.as_deref(), &options, &settings) {
+        Ok(path) => {
+            if !args.quiet {
+                eprintln!("g2tess: drew {}", path.display());
+            }
+            EXIT_OK
+        }
+        Err(e) => {
+            eprintln!("g2tess: error: {e}");
+            EXIT_SOME_FAILED
         }
     }
 }

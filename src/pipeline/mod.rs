@@ -262,6 +262,39 @@ pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<Str
         .collect())
 }
 
+/// One mesh's welded edges and the h resolved for each, as the surface would use them.
+#[derive(Debug, Clone)]
+pub struct ResolvedEdges {
+    /// The glTF mesh.
+    pub mesh: usize,
+    /// Its welded adjacency (edge kinds, welded positions).
+    pub topo: crate::topology::Topology,
+    /// One h per edge of `topo`.
+    pub h: Vec<f64>,
+}
+
+/// The h of every welded edge of every mesh of `doc` (read from `asset`), resolved from the
+/// same sources and options as processing would: what the `h` picture draws.
+pub fn resolved_edges(
+    doc: &Document,
+    asset: &Path,
+    options: &Options,
+) -> Result<Vec<ResolvedEdges>, Error> {
+    let sharpness = asset_sharpness(doc, asset, options)?;
+    // Meshes are independent, as in processing: resolved in parallel, collected in file order.
+    mesh_inputs(doc, asset)?
+        .par_iter()
+        .map(|m| {
+            let resolved = mesh_job::resolve(m, &sharpness, options, asset, &mut Vec::new())?;
+            Ok(ResolvedEdges {
+                mesh: m.mesh,
+                topo: resolved.topo,
+                h: resolved.params.h,
+            })
+        })
+        .collect()
+}
+
 /// Tangents are regenerated when the input had them, or when the primitive's material has a
 /// normal texture (a renderer would otherwise derive them per pixel from screen derivatives,
 /// which no longer match a bake against the low-poly mesh).
