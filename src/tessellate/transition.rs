@@ -259,12 +259,7 @@ fn stitched_triangles(pattern: &Pattern) -> Vec<[u32; 3]> {
 /// outer ring, or along the inner one) is taken: of those positively oriented, containing no
 /// other ring point and whose new diagonal stays outside the inner polygon, the one with the
 /// larger minimum angle.
-fn stitch(
-    outer: &[u32],
-    inner: &[u32],
-    at: &dyn Fn(u32) -> [f64; 2],
-    out: &mut Vec<[u32; 3]>,
-) {
+fn stitch(outer: &[u32], inner: &[u32], at: &dyn Fn(u32) -> [f64; 2], out: &mut Vec<[u32; 3]>) {
     let (p, q) = (outer.len(), inner.len());
     let o = |i: usize| outer[i % p];
     let inn = |j: usize| inner[j % q];
@@ -288,8 +283,8 @@ fn stitch(
                 && visible(diagonal.0, at(diagonal.1));
             valid.then(|| min_angle(a, b, c))
         };
-        let outer_score =
-            outer_step.and_then(|t| score(t, if q > 1 { inn(j + 1) } else { o(i + 2) }, (j, o(i + 1))));
+        let outer_score = outer_step
+            .and_then(|t| score(t, if q > 1 { inn(j + 1) } else { o(i + 2) }, (j, o(i + 1))));
         let inner_score = inner_step.and_then(|t| score(t, o(i + 1), (j + 1, o(i))));
         let take_outer = match (outer_score, inner_score) {
             (Some(a), Some(b)) => a >= b,
@@ -340,7 +335,11 @@ mod tests {
     fn check(key: PatternKey) -> f64 {
         let pattern = Pattern::new(key);
         let at = |p: u32| domain(pattern.bary(p));
-        assert_eq!(pattern.triangles.len() as u64, key.triangle_count(), "{key:?}");
+        assert_eq!(
+            pattern.triangles.len() as u64,
+            key.triangle_count(),
+            "{key:?}"
+        );
         let mut area = 0.0;
         let mut worst = f64::MAX;
         let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
@@ -355,7 +354,10 @@ mod tests {
             }
         }
         let whole = (0.75f64).sqrt() / 2.0;
-        assert!((area - whole).abs() < 1e-12 * whole.max(1.0), "{key:?}: area {area}");
+        assert!(
+            (area - whole).abs() < 1e-12 * whole.max(1.0),
+            "{key:?}: area {area}"
+        );
         let boundary: usize = key.edges.iter().map(|&e| e as usize).sum();
         let mut unpaired = 0;
         for (&(a, b), &count) in &directed {
@@ -367,7 +369,11 @@ mod tests {
         assert_eq!(unpaired, boundary, "{key:?}: boundary segments");
         let used: std::collections::HashSet<u32> =
             pattern.triangles.iter().flatten().copied().collect();
-        assert_eq!(used.len(), pattern.lattice.len(), "{key:?}: every point used");
+        assert_eq!(
+            used.len(),
+            pattern.lattice.len(),
+            "{key:?}: every point used"
+        );
         worst
     }
 
