@@ -32,9 +32,16 @@ fn run(mesh: &TriMesh, h: f64, tolerance: f64, cap: u32) -> Run {
     let counts = ChordErrors::probe(mesh, &topo, &surface)
         .refine_to_tolerance(&topo, &surface, tolerance, cap);
     let group = 0..mesh.triangles.len();
-    let dense = tessellate_with_counts(mesh, &topo, &hs, &surface, &counts, &[group.clone()])
-        .pop()
-        .unwrap();
+    let dense = tessellate_with_counts(
+        mesh,
+        &topo,
+        &hs,
+        &surface,
+        &counts,
+        std::slice::from_ref(&group),
+    )
+    .pop()
+    .unwrap();
     let measured = chord_error(&topo, &surface, &counts, group, &dense);
     Run {
         topo,
@@ -137,7 +144,14 @@ fn uniform_reaching(mesh: &TriMesh, tolerance: f64) -> (u32, usize) {
     let group = 0..mesh.triangles.len();
     let error = |level: u32| {
         let counts = SegmentCounts::uniform(&topo, level);
-        let dense = tessellate(mesh, &topo, &hs, &surface, level, &[group.clone()]);
+        let dense = tessellate(
+            mesh,
+            &topo,
+            &hs,
+            &surface,
+            level,
+            std::slice::from_ref(&group),
+        );
         chord_error(&topo, &surface, &counts, group.clone(), &dense[0])
     };
     let (mut lo, mut hi) = (0u32, 64u32);

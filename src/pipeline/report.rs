@@ -209,6 +209,10 @@ pub struct MeshReport {
     pub primitives: Vec<PrimitiveReport>,
     /// Continuity across its edges.
     pub edges: EdgeFigures,
+    /// Tolerance, measured chord error and triangle shape, when tessellated to a tolerance
+    /// or budget.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<super::density::AdaptiveFigures>,
     /// What was repaired or ignored, one sentence each.
     pub warnings: Vec<String>,
     /// Its stage times.

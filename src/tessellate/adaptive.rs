@@ -169,7 +169,7 @@ fn tessellate_group(shared: &Shared<'_>, h: &[f64], range: Range<usize>) -> Dens
         |tri, k| counts.edges[topo.tri_edges[tri][k].0 as usize] - 1,
         |tri| {
             let m = counts.inner[tri];
-            (m.saturating_sub(1) * m.saturating_sub(2) / 2) as u32
+            m.saturating_sub(1) * m.saturating_sub(2) / 2
         },
     );
     // First index of each source triangle's triangles.
@@ -262,9 +262,9 @@ fn tessellate_block(
         local.clear();
         local.resize(pattern.lattice.len(), 0);
 
-        for c in 0..3 {
+        for (c, point) in local.iter_mut().take(3).enumerate() {
             let slot = layout.corner_slot[3 * offset + c] as usize;
-            local[c] = slot as u32;
+            *point = slot as u32;
             if owns & (1 << c) != 0 {
                 let (position, normal) = corner_vertex(mesh, surface, tri, c);
                 block.put(slot, position, normal, source(c as u32));

@@ -143,7 +143,10 @@ impl ChordErrors {
                 })
                 .collect();
             measured.clone_from_slice(&keys.into_iter().map(Some).collect::<Vec<_>>());
+            // Each failing triangle scales its interior and edges from this round's counts; an
+            // edge between two failing triangles takes the larger, not both in turn.
             let mut raised = false;
+            let edges_before = counts.edges.clone();
             for (t, error) in over {
                 let factor = (error / tolerance).sqrt() * 1.05;
                 let scale = |c: u32| ((f64::from(c) * factor).ceil() as u32).max(c + 1).min(cap);
@@ -151,10 +154,10 @@ impl ChordErrors {
                 raised |= inner > counts.inner[t];
                 counts.inner[t] = inner;
                 for e in topo.tri_edges[t] {
-                    let count = &mut counts.edges[e.0 as usize];
-                    let next = scale(*count);
-                    raised |= next > *count;
-                    *count = next;
+                    let e = e.0 as usize;
+                    let next = scale(edges_before[e]);
+                    raised |= next > counts.edges[e];
+                    counts.edges[e] = counts.edges[e].max(next);
                 }
             }
             if !raised {
