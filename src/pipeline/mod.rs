@@ -26,6 +26,7 @@ use crate::gltf_io::{self, Document, PrimitiveData, WriteOptions};
 use crate::options::Options;
 use crate::sharpness::{explain_rows, AssetSharpness, Defaults, Sidecar};
 
+pub use density::AdaptiveFigures;
 pub use error::Error;
 pub use mesh_job::{MeshInput, MeshOutput};
 pub use report::{EdgeFigures, FileReport, MeshReport, PrimitiveReport, StageTimes};
