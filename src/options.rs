@@ -13,6 +13,14 @@ use crate::surface::SchemeParams;
 pub const DEFAULT_LEVEL: u32 = 4;
 /// Largest accepted level (level² triangles per input triangle).
 pub const MAX_LEVEL: u32 = 64;
+/// Default chord tolerance in world units: 0, off (the level decides).
+pub const DEFAULT_TOLERANCE: f64 = 0.0;
+/// Default chord tolerance as a fraction of each mesh's bounding-box diagonal: 0, off.
+pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 0.0;
+/// Default triangle budget per mesh: 0, none.
+pub const DEFAULT_TRIANGLE_BUDGET: u64 = 0;
+/// Default cap on segments per edge (and inner level) under a tolerance or budget.
+pub const DEFAULT_MAX_SEGMENTS: u32 = MAX_LEVEL;
 /// Default blend width `h`, in the paper's reference triangle (0.6 of the maximum).
 pub const DEFAULT_H: f64 = 0.212;
 /// Largest blend width: √2/4, a quarter of the reference triangle's side (the surface's one
@@ -157,6 +165,19 @@ pub fn clamp_h(h: f64) -> f64 {
 pub struct Options {
     /// Segments per input edge. Default: [`DEFAULT_LEVEL`]; range 1..=[`MAX_LEVEL`].
     pub level: u32,
+    /// Chord tolerance in world units; 0 is off. With it (or the relative one, or a budget)
+    /// each edge gets its own segment count and `level` is not used. Default:
+    /// [`DEFAULT_TOLERANCE`]; at least 0.
+    pub tolerance: f64,
+    /// Chord tolerance as a fraction of each mesh's bounding-box diagonal; 0 is off. With both
+    /// tolerances set, the smaller applies. Default: [`DEFAULT_RELATIVE_TOLERANCE`]; 0 to 1.
+    pub relative_tolerance: f64,
+    /// Output triangles per mesh; 0 is none. Wins over the tolerances: the largest tolerance
+    /// whose counts fit. Default: [`DEFAULT_TRIANGLE_BUDGET`].
+    pub triangle_budget: u64,
+    /// Cap on segments per edge under a tolerance or budget. Default: [`DEFAULT_MAX_SEGMENTS`];
+    /// range 1..=[`MAX_LEVEL`].
+    pub max_segments: u32,
     /// Blend width for edges with no other source. Default: [`DEFAULT_H`]; range 0..=[`MAX_H`].
     pub h: f64,
     /// Crease angle in degrees. Default: [`DEFAULT_CREASE_ANGLE`]; range 0..=180.
@@ -230,6 +251,10 @@ impl Default for Options {
     fn default() -> Self {
         Self {
             level: DEFAULT_LEVEL,
+            tolerance: DEFAULT_TOLERANCE,
+            relative_tolerance: DEFAULT_RELATIVE_TOLERANCE,
+            triangle_budget: DEFAULT_TRIANGLE_BUDGET,
+            max_segments: DEFAULT_MAX_SEGMENTS,
             h: DEFAULT_H,
             crease_angle: DEFAULT_CREASE_ANGLE,
             profile: DEFAULT_PROFILE,
@@ -258,6 +283,10 @@ impl Default for Options {
 #[serde(deny_unknown_fields)]
 pub struct ConfigFile {
     pub level: Option<u32>,
+    pub tolerance: Option<f64>,
+    pub relative_tolerance: Option<f64>,
+    pub triangle_budget: Option<u64>,
+    pub max_segments: Option<u32>,
     pub h: Option<f64>,
     pub crease_angle: Option<f64>,
     pub profile: Option<Profile>,
@@ -306,6 +335,10 @@ impl Options {
         }
         take!(
             level,
+            tolerance,
+            relative_tolerance,
+            triangle_budget,
+            max_segments,
             h,
             crease_angle,
             profile,
@@ -343,10 +376,36 @@ impl Options {
                 return err(setting.key, what);
             }
         }
+        if !(self.tolerance >= 0.0 && self.tolerance.is_finite()) {
+            return err(
+                "tolerance",
+                format!("is {} (expected 0 or more world units)", self.tolerance),
+            );
+        }
+        if !(0.0..=1.0).contains(&self.relative_tolerance) {
+            return err(
+                "relative_tolerance",
+                format!(
+                    "is {} (expected 0 to 1, a fraction of the bounding-box diagonal)",
+                    self.relative_tolerance
+                ),
+            );
+        }
+        if !(1..=MAX_LEVEL).contains(&self.max_segments) {
+            return err(
+                "max_segments",
+                format!("is {} (expected 1 to {MAX_LEVEL})", self.max_segments),
+            );
+        }
         if self.max_output_triangles == 0 {
             return err("max_output_triangles", "is 0 (expected at least 1)".into());
         }
         Ok(())
+    }
+
+    /// Whether each edge gets its own segment count (a tolerance or a budget is set).
+    pub fn adaptive(&self) -> bool {
+        self.tolerance > 0.0 || self.relative_tolerance > 0.0 || self.triangle_budget > 0
     }
 
     /// The surface parameters these options imply.

@@ -37,6 +37,23 @@ pub struct Args {
     #[arg(long, help_heading = "Surface")]
     pub level: Option<u32>,
 
+    /// Tessellate to this chord error in world units instead of --level: each edge gets its own
+    /// segment count, flat parts stay coarse [default: off]
+    #[arg(long, value_name = "E", help_heading = "Surface")]
+    pub tolerance: Option<f64>,
+
+    /// Chord error as a fraction of each mesh's bounding-box diagonal (e.g. 0.001) [default: off]
+    #[arg(long, value_name = "F", help_heading = "Surface")]
+    pub relative_tolerance: Option<f64>,
+
+    /// Output triangles per mesh: the finest tolerance that fits [default: none]
+    #[arg(long, value_name = "N", help_heading = "Surface")]
+    pub triangle_budget: Option<u64>,
+
+    /// Cap on segments per edge with a tolerance or budget, 1 to 64 [default: 64]
+    #[arg(long, value_name = "N", help_heading = "Surface")]
+    pub max_segments: Option<u32>,
+
     /// Blend width h of edges without their own, 0 to 0.3536 [default: 0.212]
     #[arg(long, help_heading = "Surface")]
     pub h: Option<f64>,
@@ -375,6 +392,10 @@ impl Args {
     fn flag_settings(&self) -> ConfigFile {
         ConfigFile {
             level: self.level,
+            tolerance: self.tolerance,
+            relative_tolerance: self.relative_tolerance,
+            triangle_budget: self.triangle_budget,
+            max_segments: self.max_segments,
             h: self.h,
             crease_angle: self.crease_angle,
             profile: self.profile.map(|p| match p {

@@ -12,6 +12,7 @@ use std::time::Instant;
 use glam::DVec3;
 use serde_json::Value;
 
+use super::density::Density;
 use super::error::Error;
 use super::morph;
 use super::primitive_out::{self, Prepared};
@@ -21,7 +22,6 @@ use crate::mesh::TriMesh;
 use crate::options::Options;
 use crate::sharpness::{AssetSharpness, EdgeParams, MeshContext, PrimitiveContext};
 use crate::surface::{scheme, Surface};
-use crate::tessellate::tessellate;
 use crate::topology::Topology;
 use crate::{normals, optimize};
 
@@ -168,15 +168,26 @@ pub fn smooth_mesh(
     stop_if_cancelled(options, asset)?;
 
     let tess_start = Instant::now();
-    let mut dense = tessellate(
-        &mesh,
-        &topo,
-        &params.effective,
-        surface.as_ref(),
-        level,
-        &groups,
-    );
+    let density = Density::choose(options, level, &mesh, &topo, surface.as_ref());
+    let planned = density.triangle_count(&mesh, &topo);
+    if planned > options.max_output_triangles {
+        return Err(Error::limit(
+            asset,
+            format!(
+                "mesh {} would get {planned} triangles, over --max-triangles {} (expected a larger tolerance, a --triangle-budget or a larger --max-triangles)",
+                input.mesh, options.max_output_triangles
+            ),
+        ));
+    }
+    let mut dense = density.tessellate(&mesh, &topo, &params.effective, surface.as_ref(), &groups);
     report.times.tessellate = tess_start.elapsed().as_secs_f64();
+    report.adaptive = density.figures(
+        &topo,
+        surface.as_ref(),
+        &groups,
+        &dense,
+        options.report_figures,
+    );
     // The surface holds about 1 kB per input triangle: free it before the attributes are
     // carried, when the dense mesh is at its largest.
     drop(surface);
@@ -195,14 +206,7 @@ pub fn smooth_mesh(
     let attr_start = Instant::now();
     let mut primitives = Vec::with_capacity(prepared.len());
     let targets = morph::targets(
-        &mesh,
-        &topo,
-        &params.effective,
-        &prepared,
-        &groups,
-        level,
-        options,
-        &remaps,
+        &mesh, &topo, &params.effective, &prepared, &groups, &density, options, &remaps,
     );
     for (k, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
         report.primitives.push(PrimitiveReport {

@@ -9,6 +9,7 @@
 //! share vertices (a character's head and body with different materials), then split again.
 
 mod checks;
+mod density;
 mod error;
 mod mesh_job;
 mod morph;
@@ -24,6 +25,7 @@ use crate::gltf_io::{self, Document, PrimitiveData, WriteOptions};
 use crate::options::Options;
 use crate::sharpness::{explain_rows, AssetSharpness, Defaults, Sidecar};
 
+pub use density::AdaptiveFigures;
 pub use error::Error;
 pub use mesh_job::{MeshInput, MeshOutput};
 pub use report::{EdgeFigures, FileReport, MeshReport, PrimitiveReport, StageTimes};
@@ -123,8 +125,10 @@ pub fn process_document(
     let sharpness = asset_sharpness(doc, asset, options)?;
     let level = sharpness.level().unwrap_or(options.level);
 
-    // Refuse what would not fit before decoding or allocating any of it.
-    check_output_size(doc, level, options, asset)?;
+    // Refuse what would not fit before decoding or allocating any of it. Per-edge counts are
+    // known only once a mesh's surface is built: that mesh is checked then, here its floor.
+    let floor = if options.adaptive() { 1 } else { level };
+    check_output_size(doc, floor, options, asset)?;
 
     // Decode every triangle primitive first (the document is only read here).
     let decode_start = Instant::now();

@@ -1,5 +1,5 @@
 //! Morph targets on the smooth surface: each target's displaced mesh is smoothed with the same
-//! topology, h and lattice, so its dense vertices correspond one to one with the base's.
+//! topology, h and lattice (or per-edge counts), so its dense vertices correspond one to one with the base's.
 //!
 //! Interpolating the input deltas instead would move the dense vertices along the flat
 //! low-poly triangles; re-evaluating the surface keeps the morphed shape as smooth as the base.
@@ -10,12 +10,12 @@ use std::ops::Range;
 
 use glam::DVec3;
 
+use super::density::Density;
 use super::primitive_out::Prepared;
 use crate::gltf_io::MorphDeltas;
 use crate::mesh::TriMesh;
 use crate::optimize::remap_stream;
 use crate::options::Options;
-use crate::tessellate::tessellate;
 use crate::topology::Topology;
 
 /// The surface of one morph target at the output vertices of one primitive.
@@ -38,7 +38,7 @@ pub fn targets(
     h: &[f64],
     prepared: &[Prepared],
     groups: &[Range<usize>],
-    level: u32,
+    density: &Density,
     options: &Options,
     remaps: &[Option<Vec<u32>>],
 ) -> Vec<Vec<TargetSurface>> {
@@ -51,7 +51,7 @@ pub fn targets(
     for t in 0..count {
         let moved = displaced(mesh, prepared, t);
         let (surface, _) = super::mesh_job::build_surface(options, &moved, topo, h);
-        let dense = tessellate(&moved, topo, h, surface.as_ref(), level, groups);
+        let dense = density.tessellate(&moved, topo, h, surface.as_ref(), groups);
         for (k, d) in dense.into_iter().enumerate() {
             let (positions, normals) = match &remaps[k] {
                 Some(remap) => {

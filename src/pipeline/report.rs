@@ -7,6 +7,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::density::AdaptiveFigures;
 use crate::continuity::angle_deg;
 use crate::optimize::CacheFigures;
 use crate::surface::blend::map_point;
@@ -209,6 +210,10 @@ pub struct MeshReport {
     pub primitives: Vec<PrimitiveReport>,
     /// Continuity across its edges.
     pub edges: EdgeFigures,
+    /// Tolerance, measured chord error and triangle shape, when tessellated to a tolerance
+    /// or budget.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<AdaptiveFigures>,
     /// What was repaired or ignored, one sentence each.
     pub warnings: Vec<String>,
     /// Its stage times.

@@ -47,6 +47,20 @@ impl GroupLayout {
         range: Range<usize>,
     ) -> GroupLayout {
         let per_edge = n.saturating_sub(1);
+        Self::with_counts(mesh, topo, h, range, |_, _| per_edge, |_| interior as u32)
+    }
+
+    /// As [`GroupLayout::new`], with `per_edge(tri, k)` samples on the edge opposite corner `k`
+    /// of source triangle `tri` (the same for every triangle on that input edge) and
+    /// `interior(tri)` interior points.
+    pub fn with_counts(
+        mesh: &TriMesh,
+        topo: &Topology,
+        h: &[f64],
+        range: Range<usize>,
+        per_edge: impl Fn(usize, usize) -> u32,
+        interior: impl Fn(usize) -> u32,
+    ) -> GroupLayout {
         let count = range.len();
         let first_half = first_use_of_each_input_edge(mesh, topo, h, range.clone());
         let mut corner_of_vertex = vec![u32::MAX; mesh.positions.len()];
@@ -74,14 +88,15 @@ impl GroupLayout {
                 let first = first_half[half] as usize;
                 layout.edge_slot[half] = if first == half {
                     owns |= 8 << k;
-                    next += per_edge;
-                    next - per_edge
+                    let samples = per_edge(tri, k);
+                    next += samples;
+                    next - samples
                 } else {
                     layout.edge_slot[first]
                 };
             }
             layout.owns[offset] = owns;
-            next += interior as u32;
+            next += interior(tri);
         }
         layout.base.push(next);
         layout

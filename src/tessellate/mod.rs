@@ -36,9 +36,13 @@
 //! cache-friendly bands and vertices in order of first use, so meshoptimizer's passes have
 //! little left to do (`optimize.rs` measures it).
 
+mod adaptive;
+mod chord;
+mod counts;
 mod lattice_edges;
 mod layout;
 mod plan;
+mod transition;
 
 use crate::mesh::TriMesh;
 use crate::surface::{lattice_bary, LatticePart, Surface, SurfacePoint};
@@ -47,6 +51,10 @@ use layout::GroupLayout;
 use plan::LatticePlan;
 use rayon::prelude::*;
 use std::ops::Range;
+
+pub use adaptive::tessellate_with_counts;
+pub use chord::chord_error;
+pub use counts::{ChordErrors, SegmentCounts, PROBE_LEVEL};
 
 /// Where an output vertex was sampled: a source triangle (index into the whole mesh) and a point
 /// of that triangle's level-n lattice. Attributes are interpolated from these.
@@ -237,6 +245,31 @@ fn is_crease(topo: &Topology, h: &[f64], e: EdgeId) -> bool {
     h.get(e.0 as usize).is_some_and(|&v| v == 0.0) && topo.edges[e.0 as usize].tris.len() >= 2
 }
 
+/// Position and normal of corner `c` of `tri` as written: the vertex's own position, not its
+/// welded representative (welding equates -0.0 and +0.0, and the input's bits are kept), and
+/// its normalized input normal (the contract of `Surface::evaluate` at a corner); only a
+/// degenerate input normal needs the surface's fallback.
+fn corner_vertex(
+    mesh: &TriMesh,
+    surface: &dyn Surface,
+    tri: usize,
+    c: usize,
+) -> ([f32; 3], [f32; 3]) {
+    let v = mesh.triangles[tri][c] as usize;
+    let normal = match mesh.normals[v].try_normalize() {
+        Some(normal) => normal,
+        None => {
+            let mut bary = [0.0; 3];
+            bary[c] = 1.0;
+            surface.evaluate(tri, bary).normal
+        }
+    };
+    (
+        mesh.positions[v].as_vec3().to_array(),
+        normal.as_vec3().to_array(),
+    )
+}
+
 /// One block of consecutive source triangles and the slices of the final buffers it owns.
 struct Block<'a> {
     /// Triangle offsets within the group.
@@ -380,25 +413,8 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
             let slot = layout.corner_slot[3 * offset + c] as usize;
             local[li] = slot as u32;
             if owns & (1 << c) != 0 {
-                // The vertex's own position, not its welded representative: welding equates
-                // -0.0 and +0.0, and the input's bits are kept. Its normal is the normalized
-                // input normal (the contract of `Surface::evaluate` at a corner); only a
-                // degenerate input normal needs the surface's fallback.
-                let v = corners[c] as usize;
-                let normal = match mesh.normals[v].try_normalize() {
-                    Some(normal) => normal,
-                    None => {
-                        let mut bary = [0.0; 3];
-                        bary[c] = 1.0;
-                        surface.evaluate(tri, bary).normal
-                    }
-                };
-                block.put(
-                    slot,
-                    mesh.positions[v].as_vec3().to_array(),
-                    normal.as_vec3().to_array(),
-                    source(li),
-                );
+                let (position, normal) = corner_vertex(mesh, surface, tri, c);
+                block.put(slot, position, normal, source(li));
             }
         }
 

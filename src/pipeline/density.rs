@@ -1,0 +1,182 @@
+//! How finely one mesh is tessellated: one level everywhere, or a segment count per edge from a
+//! chord tolerance (world units or relative to the mesh's bounding-box diagonal) or a triangle
+//! budget, and the figures the report gives for it.
+//!
+//! It deliberately decides and measures only; the tessellators do the work, and morph targets
+//! are tessellated with the base mesh's density so their vertices correspond one to one.
+
+use std::ops::Range;
+
+use serde::Serialize;
+
+use crate::mesh::TriMesh;
+use crate::options::Options;
+use crate::surface::Surface;
+use crate::tessellate::{
+    chord_error, tessellate, tessellate_with_counts, ChordErrors, DenseMesh, SegmentCounts,
+};
+use crate::topology::Topology;
+
+/// The density of one mesh.
+#[derive(Debug, Clone)]
+pub(super) enum Density {
+    /// Every edge at this level.
+    Level(u32),
+    /// Per-edge counts, reaching `target` (the tolerance asked for, or found for the budget).
+    Counts { counts: SegmentCounts, target: f64 },
+}
+
+/// What the report says of an adaptive mesh.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct AdaptiveFigures {
+    /// The chord tolerance aimed at (asked for, or found for the budget), world units.
+    pub tolerance: f64,
+    /// The chord error measured on the output (sampled points of every output triangle
+    /// against the surface), when the report computes figures.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub chord_error: Option<f64>,
+    /// The largest segment count of any edge or interior.
+    pub max_segments: u32,
+    /// The smallest angle of any output triangle, in degrees.
+    pub min_angle_degrees: f64,
+    /// The largest ratio of longest edge to shortest altitude × 2/√3 (1 for equilateral).
+    pub max_aspect_ratio: f64,
+}
+
+impl Density {
+    /// The density the options ask for; `level` is the file's level.
+    pub fn choose(
+        options: &Options,
+        level: u32,
+        mesh: &TriMesh,
+        topo: &Topology,
+        surface: &dyn Surface,
+    ) -> Density {
+        if !options.adaptive() {
+            return Density::Level(level);
+        }
+        let cap = options.max_segments;
+        let errors = ChordErrors::probe(mesh, topo, surface);
+        if options.triangle_budget > 0 {
+            let (target, counts) = errors.for_budget(topo, options.triangle_budget, cap);
+            return Density::Counts { counts, target };
+        }
+        let mut target = f64::INFINITY;
+        if options.tolerance > 0.0 {
+            target = options.tolerance;
+        }
+        if options.relative_tolerance > 0.0 {
+            target = target.min(options.relative_tolerance * diagonal(mesh));
+        }
+        let counts = if target > 0.0 && target.is_finite() {
+            errors.refine_to_tolerance(topo, surface, target, cap)
+        } else {
+            // A mesh of one point: nothing to refine.
+            SegmentCounts::uniform(topo, 1)
+        };
+        Density::Counts { counts, target }
+    }
+
+    /// Output triangles, before tessellating.
+    pub fn triangle_count(&self, mesh: &TriMesh, topo: &Topology) -> u64 {
+        match self {
+            Density::Level(l) => mesh.triangles.len() as u64 * u64::from(l * l),
+            Density::Counts { counts, .. } => counts.triangle_count(topo),
+        }
+    }
+
+    /// Tessellates `groups` at this density.
+    pub fn tessellate(
+        &self,
+        mesh: &TriMesh,
+        topo: &Topology,
+        h: &[f64],
+        surface: &dyn Surface,
+        groups: &[Range<usize>],
+    ) -> Vec<DenseMesh> {
+        match self {
+            Density::Level(level) => tessellate(mesh, topo, h, surface, *level, groups),
+            Density::Counts { counts, .. } => {
+                tessellate_with_counts(mesh, topo, h, surface, counts, groups)
+            }
+        }
+    }
+
+    /// The report's figures: always for per-edge counts; at a uniform level only when `measure`
+    /// (then the tolerance is the measured error), so uniform and adaptive runs compare.
+    pub fn figures(
+        &self,
+        topo: &Topology,
+        surface: &dyn Surface,
+        groups: &[Range<usize>],
+        dense: &[DenseMesh],
+        measure: bool,
+    ) -> Option<AdaptiveFigures> {
+        let (counts, target) = match self {
+            Density::Counts { counts, target } => (counts.clone(), Some(*target)),
+            Density::Level(level) if measure => (SegmentCounts::uniform(topo, *level), None),
+            Density::Level(_) => return None,
+        };
+        let (mut min_angle, mut max_aspect) = (180.0f64, 1.0f64);
+        for d in dense {
+            let (a, r) = shape(d);
+            min_angle = min_angle.min(a);
+            max_aspect = max_aspect.max(r);
+        }
+        let chord = measure.then(|| {
+            groups
+                .iter()
+                .zip(dense)
+                .map(|(g, d)| chord_error(topo, surface, &counts, g.clone(), d))
+                .fold(0.0, f64::max)
+        });
+        Some(AdaptiveFigures {
+            tolerance: target.or(chord).unwrap_or(0.0),
+            chord_error: chord,
+            max_segments: counts.max(),
+            min_angle_degrees: min_angle,
+            max_aspect_ratio: max_aspect,
+        })
+    }
+}
+
+/// Length of the diagonal of the bounding box of `mesh`'s positions.
+fn diagonal(mesh: &TriMesh) -> f64 {
+    let Some(&first) = mesh.positions.first() else {
+        return 0.0;
+    };
+    let (lo, hi) = mesh
+        .positions
+        .iter()
+        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    (hi - lo).length()
+}
+
+/// Smallest angle (degrees) and largest aspect ratio of the triangles of `dense`; degenerate
+/// triangles (zero area) are skipped, as the input's own can be.
+fn shape(dense: &DenseMesh) -> (f64, f64) {
+    let p = |v: u32| glam::DVec3::from(dense.positions[v as usize].map(f64::from));
+    let (mut min_angle, mut max_aspect) = (180.0f64, 1.0f64);
+    for t in dense.indices.chunks_exact(3) {
+        let [a, b, c] = [p(t[0]), p(t[1]), p(t[2])];
+        let twice_area = (b - a).cross(c - a).length();
+        if twice_area <= 0.0 {
+            continue;
+        }
+        let sides = [(b - c).length(), (c - a).length(), (a - b).length()];
+        let longest = sides.iter().copied().fold(0.0, f64::max);
+        // Smallest angle is opposite the shortest side: sin = 2A / (product of the other two).
+        let angle = |k: usize| {
+            let (u, v) = (sides[(k + 1) % 3], sides[(k + 2) % 3]);
+            (twice_area / (u * v)).clamp(-1.0, 1.0).asin().to_degrees()
+        };
+        let shortest = (0..3)
+            .min_by(|&x, &y| sides[x].total_cmp(&sides[y]))
+            .unwrap_or(0);
+        min_angle = min_angle.min(angle(shortest));
+        // Longest edge over the altitude onto it, scaled so the equilateral triangle gives 1.
+        let altitude = twice_area / longest;
+        max_aspect = max_aspect.max(longest / altitude * (3f64.sqrt() / 2.0));
+    }
+    (min_angle, max_aspect)
+}

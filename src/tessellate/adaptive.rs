@@ -1,0 +1,337 @@
+//! Tessellation with a segment count per welded edge and an inner level per triangle
+//! ([`SegmentCounts`]), each source triangle cut by the transition pattern of its counts.
+//!
+//! Everything the uniform tessellator guarantees holds here, by the same means: a welded
+//! edge's samples are evaluated once, by its evaluator, and written to both sides, so the
+//! output is watertight bit for bit; corners are the input vertices; vertices are numbered by
+//! [`GroupLayout`] (owned corners, owned edges, interior, per source triangle in order), so
+//! blocks write disjoint slices and the bytes do not depend on the thread count; output
+//! vertices are split where the input is and across creases. Every output vertex is a lattice
+//! point of its own level ([`VertexSource`]), so attributes, split normals, morph targets and
+//! skins are carried by the unchanged code of the uniform path.
+//!
+//! Patterns depend on the counts alone: each distinct `(edge counts, inner level)` is built
+//! once and shared (`transition.rs`).
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+use super::counts::SegmentCounts;
+use super::layout::GroupLayout;
+use super::transition::{Pattern, PatternKey};
+use super::{
+    canonical_forward, corner_vertex, evaluator, DenseMesh, VertexSource, BLOCK_TRIANGLES,
+};
+use crate::mesh::TriMesh;
+use crate::surface::{LatticePart, Surface, SurfacePoint};
+use crate::topology::Topology;
+
+/// Tessellates `groups` of `mesh` with `counts`; `h` as for [`super::tessellate`].
+///
+/// # Panics
+/// If a count is 0 or above 255 (a caller bug: the options cap them).
+pub fn tessellate_with_counts(
+    mesh: &TriMesh,
+    topo: &Topology,
+    h: &[f64],
+    surface: &dyn Surface,
+    counts: &SegmentCounts,
+    groups: &[Range<usize>],
+) -> Vec<DenseMesh> {
+    let keys: Vec<PatternKey> = (0..mesh.triangles.len())
+        .into_par_iter()
+        .map(|t| counts.key(topo, t))
+        .collect();
+    let mut distinct = keys.clone();
+    distinct.par_sort_unstable();
+    distinct.dedup();
+    let patterns: Vec<Pattern> = distinct.par_iter().map(|&k| Pattern::new(k)).collect();
+    let pattern_of: Vec<u32> = keys
+        .par_iter()
+        .map(|k| distinct.binary_search(k).expect("every key was built") as u32)
+        .collect();
+    let edge_samples = shared_edge_samples(topo, surface, &counts.edges);
+    let shared = Shared {
+        mesh,
+        topo,
+        surface,
+        counts,
+        patterns: &patterns,
+        pattern_of: &pattern_of,
+        edge_samples: &edge_samples,
+    };
+    groups
+        .par_iter()
+        .map(|range| tessellate_group(&shared, h, range.clone()))
+        .collect()
+}
+
+/// The samples of every welded edge, `count − 1` per edge from `start[e]`, in the edge's
+/// canonical direction.
+struct EdgeSamples {
+    start: Vec<usize>,
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+}
+
+fn shared_edge_samples(topo: &Topology, surface: &dyn Surface, counts: &[u32]) -> EdgeSamples {
+    let mut start = Vec::with_capacity(counts.len() + 1);
+    let mut total = 0usize;
+    for &c in counts {
+        start.push(total);
+        total += c.saturating_sub(1) as usize;
+    }
+    start.push(total);
+    let mut positions = vec![[0.0f32; 3]; total];
+    let mut normals = vec![[0.0f32; 3]; total];
+    let mut slices = Vec::with_capacity(counts.len());
+    let (mut p_rest, mut n_rest) = (&mut positions[..], &mut normals[..]);
+    for e in 0..counts.len() {
+        let len = start[e + 1] - start[e];
+        let (p, pr) = std::mem::take(&mut p_rest).split_at_mut(len);
+        let (n, nr) = std::mem::take(&mut n_rest).split_at_mut(len);
+        (p_rest, n_rest) = (pr, nr);
+        slices.push((e, p, n));
+    }
+    slices.into_par_iter().for_each_init(
+        Vec::new,
+        |values: &mut Vec<SurfacePoint>, (e, positions, normals)| {
+            let Some((tri, k)) = evaluator(topo, e) else {
+                return;
+            };
+            if positions.is_empty() {
+                return;
+            }
+            let n = counts[e];
+            values.clear();
+            surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), values);
+            let forward = canonical_forward(topo, tri, k);
+            for (m, p) in (1..n).zip(values.iter()) {
+                let slot = (if forward { m } else { n - m } - 1) as usize;
+                positions[slot] = p.position.as_vec3().to_array();
+                normals[slot] = p.normal.as_vec3().to_array();
+            }
+        },
+    );
+    EdgeSamples {
+        start,
+        positions,
+        normals,
+    }
+}
+
+/// What every block reads.
+struct Shared<'a> {
+    mesh: &'a TriMesh,
+    topo: &'a Topology,
+    surface: &'a dyn Surface,
+    counts: &'a SegmentCounts,
+    patterns: &'a [Pattern],
+    pattern_of: &'a [u32],
+    edge_samples: &'a EdgeSamples,
+}
+
+impl Shared<'_> {
+    fn pattern(&self, tri: usize) -> &Pattern {
+        &self.patterns[self.pattern_of[tri] as usize]
+    }
+}
+
+/// One block of consecutive source triangles and the slices of the final buffers it owns.
+struct Block<'a> {
+    tris: Range<usize>,
+    vertex_base: usize,
+    index_base: usize,
+    positions: &'a mut [[f32; 3]],
+    normals: &'a mut [[f32; 3]],
+    sources: &'a mut [VertexSource],
+    indices: &'a mut [u32],
+}
+
+impl Block<'_> {
+    #[inline]
+    fn put(&mut self, slot: usize, position: [f32; 3], normal: [f32; 3], source: VertexSource) {
+        let at = slot - self.vertex_base;
+        self.positions[at] = position;
+        self.normals[at] = normal;
+        self.sources[at] = source;
+    }
+}
+
+fn tessellate_group(shared: &Shared<'_>, h: &[f64], range: Range<usize>) -> DenseMesh {
+    let (mesh, topo, counts) = (shared.mesh, shared.topo, shared.counts);
+    let layout = GroupLayout::with_counts(
+        mesh,
+        topo,
+        h,
+        range.clone(),
+        |tri, k| counts.edges[topo.tri_edges[tri][k].0 as usize] - 1,
+        |tri| {
+            let m = counts.inner[tri];
+            m.saturating_sub(1) * m.saturating_sub(2) / 2
+        },
+    );
+    // First index of each source triangle's triangles.
+    let mut index_base = Vec::with_capacity(range.len() + 1);
+    let mut total = 0usize;
+    for tri in range.clone() {
+        index_base.push(total);
+        total += 3 * shared.pattern(tri).triangles.len();
+    }
+    index_base.push(total);
+
+    let vertex_count = layout.vertex_count();
+    let mut out = DenseMesh {
+        positions: vec![[0.0; 3]; vertex_count],
+        normals: vec![[0.0; 3]; vertex_count],
+        sources: vec![VertexSource::lattice(0, 1, 0, 0); vertex_count],
+        indices: vec![0; total],
+    };
+    let mut blocks = Vec::new();
+    let (mut positions, mut normals, mut sources, mut indices) = (
+        &mut out.positions[..],
+        &mut out.normals[..],
+        &mut out.sources[..],
+        &mut out.indices[..],
+    );
+    let mut start = 0;
+    while start < range.len() {
+        // Whole source triangles up to about BLOCK_TRIANGLES output triangles.
+        let mut end = start + 1;
+        while end < range.len() && index_base[end + 1] - index_base[start] <= 3 * BLOCK_TRIANGLES {
+            end += 1;
+        }
+        let vertex_base = layout.base[start] as usize;
+        let vertices = layout.base[end] as usize - vertex_base;
+        let (p, rest_p) = std::mem::take(&mut positions).split_at_mut(vertices);
+        let (nr, rest_n) = std::mem::take(&mut normals).split_at_mut(vertices);
+        let (s, rest_s) = std::mem::take(&mut sources).split_at_mut(vertices);
+        let (i, rest_i) =
+            std::mem::take(&mut indices).split_at_mut(index_base[end] - index_base[start]);
+        (positions, normals, sources, indices) = (rest_p, rest_n, rest_s, rest_i);
+        blocks.push(Block {
+            tris: start..end,
+            vertex_base,
+            index_base: index_base[start],
+            positions: p,
+            normals: nr,
+            sources: s,
+            indices: i,
+        });
+        start = end;
+    }
+    blocks
+        .into_par_iter()
+        .for_each(|block| tessellate_block(shared, &layout, &index_base, range.start, block));
+    out
+}
+
+/// Writes the vertices a block owns and all its triangles, each vertex evaluated once (see
+/// the uniform path's `tessellate_block`, which this follows point for point).
+fn tessellate_block(
+    shared: &Shared<'_>,
+    layout: &GroupLayout,
+    index_base: &[usize],
+    first_tri: usize,
+    mut block: Block<'_>,
+) {
+    let (mesh, topo, surface, edge_samples) = (
+        shared.mesh,
+        shared.topo,
+        shared.surface,
+        shared.edge_samples,
+    );
+    let mut interior: Vec<SurfacePoint> = Vec::new();
+    let mut own_edge: Vec<SurfacePoint> = Vec::new();
+    let mut local: Vec<u32> = Vec::new();
+    for offset in block.tris.clone() {
+        let tri = first_tri + offset;
+        let pattern = shared.pattern(tri);
+        let corners = mesh.triangles[tri];
+        let owns = layout.owns[offset];
+        let source = |p: u32| {
+            let [level, i, j] = pattern.lattice[p as usize];
+            VertexSource {
+                tri: tri as u32,
+                level,
+                i,
+                j,
+            }
+        };
+        local.clear();
+        local.resize(pattern.lattice.len(), 0);
+
+        for (c, point) in local.iter_mut().take(3).enumerate() {
+            let slot = layout.corner_slot[3 * offset + c] as usize;
+            *point = slot as u32;
+            if owns & (1 << c) != 0 {
+                let (position, normal) = corner_vertex(mesh, surface, tri, c);
+                block.put(slot, position, normal, source(c as u32));
+            }
+        }
+
+        for k in 0..3 {
+            let n = pattern.key.edges[k];
+            let (a, b) = (corners[(k + 1) % 3], corners[(k + 2) % 3]);
+            let first = layout.edge_slot[3 * offset + k] as usize;
+            let slot = |m: u32| first + (if a <= b { m } else { n - m } - 1) as usize;
+            let point = |m: u32| pattern.edge_start[k] + m - 1;
+            if owns & (8 << k) == 0 {
+                for m in 1..n {
+                    local[point(m) as usize] = slot(m) as u32;
+                }
+                continue;
+            }
+            let e = topo.tri_edges[tri][k].0 as usize;
+            let forward = canonical_forward(topo, tri, k);
+            let evaluated_here = evaluator(topo, e) == Some((tri, k));
+            if !evaluated_here {
+                own_edge.clear();
+                surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut own_edge);
+            }
+            for m in 1..n {
+                let s = slot(m);
+                local[point(m) as usize] = s as u32;
+                let welded = edge_samples.start[e] + (if forward { m } else { n - m } - 1) as usize;
+                let normal = if evaluated_here {
+                    edge_samples.normals[welded]
+                } else {
+                    own_edge[(m - 1) as usize].normal.as_vec3().to_array()
+                };
+                block.put(s, edge_samples.positions[welded], normal, source(point(m)));
+            }
+        }
+
+        if !pattern.interior_by_rank.is_empty() {
+            interior.clear();
+            surface.evaluate_lattice_part(
+                tri,
+                pattern.key.inner,
+                LatticePart::Interior,
+                &mut interior,
+            );
+            let interior_base = layout.base[offset + 1] as usize - pattern.interior_by_rank.len();
+            for (rank, &index) in pattern.interior_by_rank.iter().enumerate() {
+                let point = pattern.interior_start + index;
+                let slot = interior_base + rank;
+                local[point as usize] = slot as u32;
+                let p = &interior[index as usize];
+                block.put(
+                    slot,
+                    p.position.as_vec3().to_array(),
+                    p.normal.as_vec3().to_array(),
+                    source(point),
+                );
+            }
+        }
+
+        let start = index_base[offset] - block.index_base;
+        let out = &mut block.indices[start..start + 3 * pattern.triangles.len()];
+        for (dst, t) in out.chunks_exact_mut(3).zip(&pattern.triangles) {
+            dst[0] = local[t[0] as usize];
+            dst[1] = local[t[1] as usize];
+            dst[2] = local[t[2] as usize];
+        }
+    }
+}

@@ -1,0 +1,416 @@
+//! Transition patterns: how one source triangle is cut when its three edges carry their own
+//! segment counts and its interior a lattice level of its own.
+//!
+//! The pattern is the one the Direct3D 11 tessellator and OpenSubdiv's Bfr use, a regular
+//! inner lattice with a stitched ring, with two changes that keep it equal to the uniform
+//! lattice when all counts agree and keep its triangles well shaped when they do not:
+//!
+//! - the inner lattice is the interior of the level-`M` lattice (its points off the boundary),
+//!   so the ring is one lattice step wide and interior points have exact lattice coordinates;
+//! - a corner whose two edges both have room is cut off as an ear (the uniform lattice's corner
+//!   triangle) before the ring is stitched, and the stitch picks, at every step, the candidate
+//!   triangle with the larger minimum angle among those that stay outside the inner lattice.
+//!
+//! Points are numbered per pattern: the three corners, then the samples of edge 0, 1 and 2
+//! (`counts[k] − 1` each, step `m` walked from corner `k + 1`), then the level-`M` interior in
+//! [`LatticePart::Interior`](crate::surface::LatticePart) order. Each point also has lattice
+//! coordinates `(level, i, j)`: a corner at level 1, an edge sample at its edge's count, an
+//! interior point at `M`, so every output vertex is a lattice point of its own level and
+//! attributes are carried exactly as for uniform levels.
+//!
+//! It deliberately knows no mesh and no surface: patterns depend on the counts alone and are
+//! built once per distinct `(counts, M)` and shared.
+
+use super::lattice_edges::SampleKind;
+use super::plan::LatticePlan;
+
+/// Segment counts of the three edges (edge `k` opposite corner `k`) and the interior level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub(crate) struct PatternKey {
+    /// Segments along edge `k`, at least 1.
+    pub edges: [u32; 3],
+    /// Level of the inner lattice, at least the largest edge count (see `counts.rs`).
+    pub inner: u32,
+}
+
+impl PatternKey {
+    /// Number of triangles of the pattern, without building it: `Σe + M(M − 3)` with an inner
+    /// lattice (`M ≥ 3`; `M²` when all counts equal `M`), else the `Σe − 2` triangles of a
+    /// polygon with `Σe` vertices.
+    pub fn triangle_count(self) -> u64 {
+        let sum: u64 = self.edges.iter().map(|&e| u64::from(e)).sum();
+        let m = u64::from(self.inner);
+        if m >= 3 {
+            sum + m * (m - 3)
+        } else {
+            sum - 2
+        }
+    }
+}
+
+/// The triangles of one source triangle for one [`PatternKey`].
+#[derive(Debug, Clone)]
+pub(crate) struct Pattern {
+    pub key: PatternKey,
+    /// Per point: lattice coordinates `(level, i, j)` (see the module docs).
+    pub lattice: Vec<[u8; 3]>,
+    /// First point of each edge's samples.
+    pub edge_start: [u32; 3],
+    /// First interior point.
+    pub interior_start: u32,
+    /// Interior indices in order of first use by [`Pattern::triangles`] (the order they are
+    /// numbered in).
+    pub interior_by_rank: Vec<u32>,
+    /// Triangles as point indices, wound like the source triangle.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Pattern {
+    /// Builds the pattern of `key`.
+    ///
+    /// # Panics
+    /// If a count is 0 or above 255.
+    pub fn new(key: PatternKey) -> Pattern {
+        let PatternKey { edges, inner: m } = key;
+        assert!(
+            edges.iter().chain([&m]).all(|&c| (1..=255).contains(&c)),
+            "counts {key:?}"
+        );
+        let mut lattice = vec![[1, 0, 0], [1, 1, 0], [1, 0, 1]];
+        let mut edge_start = [0; 3];
+        for k in 0..3 {
+            edge_start[k] = lattice.len() as u32;
+            let e = edges[k];
+            for mstep in 1..e {
+                let (i, j) = edge_point(e, k, mstep);
+                lattice.push([e as u8, i as u8, j as u8]);
+            }
+        }
+        let interior_start = lattice.len() as u32;
+        for j in 1..m {
+            for i in 1..m.saturating_sub(j) {
+                lattice.push([m as u8, i as u8, j as u8]);
+            }
+        }
+        let mut pattern = Pattern {
+            key,
+            lattice,
+            edge_start,
+            interior_start,
+            interior_by_rank: Vec::new(),
+            triangles: Vec::new(),
+        };
+        if edges == [m; 3] {
+            pattern.triangles = uniform_triangles(&pattern, m);
+        } else {
+            pattern.triangles = stitched_triangles(&pattern);
+        }
+        let interior_points = pattern.lattice.len() - interior_start as usize;
+        let mut ranked = vec![false; interior_points];
+        for &p in pattern.triangles.iter().flatten() {
+            if let Some(index) = p.checked_sub(interior_start) {
+                if !std::mem::replace(&mut ranked[index as usize], true) {
+                    pattern.interior_by_rank.push(index);
+                }
+            }
+        }
+        debug_assert_eq!(pattern.interior_by_rank.len(), interior_points);
+        debug_assert_eq!(pattern.triangles.len() as u64, key.triangle_count());
+        pattern
+    }
+
+    /// Barycentrics of point `p`.
+    pub fn bary(&self, p: u32) -> [f64; 3] {
+        let [n, i, j] = self.lattice[p as usize].map(f64::from);
+        [(n - i - j) / n, i / n, j / n]
+    }
+
+    /// Point index of step `mstep` along edge `k` (walked from corner `k + 1`).
+    fn edge(&self, k: usize, mstep: u32) -> u32 {
+        if mstep == 0 {
+            return ((k + 1) % 3) as u32;
+        }
+        if mstep == self.key.edges[k] {
+            return ((k + 2) % 3) as u32;
+        }
+        self.edge_start[k] + mstep - 1
+    }
+
+    /// Point index of interior lattice point `(i, j)` of level `M`.
+    fn interior(&self, i: u32, j: u32) -> u32 {
+        match SampleKind::of(self.key.inner, i, j) {
+            SampleKind::Interior { index } => self.interior_start + index as u32,
+            other => unreachable!("({i}, {j}) is {other:?}"),
+        }
+    }
+}
+
+/// Lattice coordinates of step `m` along edge `k` at level `n` (the order of
+/// [`LatticePart::Edge`](crate::surface::LatticePart)).
+fn edge_point(n: u32, k: usize, m: u32) -> (u32, u32) {
+    match k {
+        0 => (n - m, m),
+        1 => (0, n - m),
+        _ => (m, 0),
+    }
+}
+
+/// The uniform level-`m` lattice in the plan's cache-friendly order.
+fn uniform_triangles(pattern: &Pattern, m: u32) -> Vec<[u32; 3]> {
+    let plan = LatticePlan::new(m);
+    let point = |li: u32| {
+        let [i, j] = plan.lattice_ij[li as usize].map(u32::from);
+        match SampleKind::of(m, i, j) {
+            SampleKind::Corner(c) => c as u32,
+            SampleKind::Edge { k, m } => pattern.edge(k, m),
+            SampleKind::Interior { index } => pattern.interior_start + index as u32,
+        }
+    };
+    plan.triangles.iter().map(|t| t.map(point)).collect()
+}
+
+/// Position of barycentrics `b` in the equilateral reference triangle of side 1, where angles
+/// are judged.
+fn domain(b: [f64; 3]) -> [f64; 2] {
+    [b[1] + 0.5 * b[2], b[2] * (0.75f64).sqrt()]
+}
+
+fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// Smallest angle of triangle `abc`, in radians (0 for a degenerate one).
+pub(crate) fn min_angle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let angle = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        let u = [q[0] - p[0], q[1] - p[1]];
+        let v = [r[0] - p[0], r[1] - p[1]];
+        let cross = u[0] * v[1] - u[1] * v[0];
+        let dot = u[0] * v[0] + u[1] * v[1];
+        cross.abs().atan2(dot)
+    };
+    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
+}
+
+/// Whether `p` lies inside or on triangle `abc` (counter-clockwise).
+fn inside(p: [f64; 2], a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> bool {
+    const EPS: f64 = 1e-12;
+    orient(a, b, p) >= -EPS && orient(b, c, p) >= -EPS && orient(c, a, p) >= -EPS
+}
+
+/// Ears, stitched ring and inner lattice (see the module docs).
+fn stitched_triangles(pattern: &Pattern) -> Vec<[u32; 3]> {
+    let PatternKey { edges, inner: m } = pattern.key;
+    let at = |p: u32| domain(pattern.bary(p));
+    let mut triangles = Vec::with_capacity(pattern.key.triangle_count() as usize);
+
+    // The outer ring, counter-clockwise from corner 0: edge 2 runs from corner 0 to corner 1,
+    // edge 0 from 1 to 2, edge 1 from 2 to 0.
+    let mut outer = Vec::new();
+    for (c, k) in [(0usize, 2usize), (1, 0), (2, 1)] {
+        // Corner c sits between edge (c + 1) % 3 (arriving) and edge (c + 2) % 3 (leaving).
+        let (arriving, leaving) = (edges[(c + 1) % 3], edges[(c + 2) % 3]);
+        let ear = m >= 3 && arriving >= 2 && leaving >= 2 && 2 * (arriving + leaving) >= 3 * m;
+        if ear {
+            triangles.push([
+                pattern.edge((c + 1) % 3, arriving - 1),
+                c as u32,
+                pattern.edge((c + 2) % 3, 1),
+            ]);
+        } else {
+            outer.push(c as u32);
+        }
+        outer.extend((1..edges[k]).map(|s| pattern.edge(k, s)));
+    }
+
+    if m < 3 {
+        clip_ears(&mut outer, &at, &mut triangles);
+        return triangles;
+    }
+
+    // The inner ring, counter-clockwise from the inner corner next to corner 0.
+    let inner: Vec<u32> = if m == 3 {
+        vec![pattern.interior(1, 1)]
+    } else {
+        let side = m - 2;
+        (1..=side)
+            .map(|i| (i, 1))
+            .chain((2..=side).map(|j| (m - 1 - j, j)))
+            .chain((2..side).rev().map(|j| (1, j)))
+            .map(|(i, j)| pattern.interior(i, j))
+            .collect()
+    };
+    stitch(&outer, &inner, &at, &mut triangles);
+
+    if m >= 4 {
+        // The inner lattice: level M − 3, shifted one step in from every edge.
+        let plan = LatticePlan::new(m - 3);
+        triangles.extend(plan.triangles.iter().map(|t| {
+            t.map(|li| {
+                let [i, j] = plan.lattice_ij[li as usize].map(u32::from);
+                pattern.interior(i + 1, j + 1)
+            })
+        }));
+    }
+    triangles
+}
+
+/// Stitches the ring between two closed counter-clockwise polygons, `outer` starting at the
+/// point facing `inner[0]`. At each step one of the two candidate triangles (advance along the
+/// outer ring, or along the inner one) is taken: of those positively oriented, containing no
+/// other ring point and whose new diagonal stays outside the inner polygon, the one with the
+/// larger minimum angle.
+fn stitch(outer: &[u32], inner: &[u32], at: &dyn Fn(u32) -> [f64; 2], out: &mut Vec<[u32; 3]>) {
+    let (p, q) = (outer.len(), inner.len());
+    let o = |i: usize| outer[i % p];
+    let inn = |j: usize| inner[j % q];
+    // Whether the diagonal from inner point j to `x` leaves j outside the inner polygon (for a
+    // convex polygon: x is not strictly inside the cone of its two edges at j).
+    let visible = |j: usize, x: [f64; 2]| {
+        if q < 3 {
+            return true;
+        }
+        let (prev, here, next) = (at(inn(j + q - 1)), at(inn(j)), at(inn(j + 1)));
+        !(orient(prev, here, x) > 1e-12 && orient(here, next, x) > 1e-12)
+    };
+    let (mut i, mut j) = (0usize, 0usize);
+    while i < p || (q > 1 && j < q) {
+        let outer_step = (i < p).then(|| [o(i), o(i + 1), inn(j)]);
+        let inner_step = (q > 1 && j < q).then(|| [o(i), inn(j + 1), inn(j)]);
+        let score = |t: [u32; 3], other: u32, diagonal: (usize, u32)| {
+            let [a, b, c] = t.map(at);
+            let valid = orient(a, b, c) > 1e-12
+                && !inside(at(other), a, b, c)
+                && visible(diagonal.0, at(diagonal.1));
+            valid.then(|| min_angle(a, b, c))
+        };
+        let outer_score = outer_step
+            .and_then(|t| score(t, if q > 1 { inn(j + 1) } else { o(i + 2) }, (j, o(i + 1))));
+        let inner_score = inner_step.and_then(|t| score(t, o(i + 1), (j + 1, o(i))));
+        let take_outer = match (outer_score, inner_score) {
+            (Some(a), Some(b)) => a >= b,
+            (Some(_), None) => true,
+            (None, Some(_)) => false,
+            (None, None) => outer_step.is_some(),
+        };
+        if take_outer {
+            out.push(outer_step.expect("an outer step remains"));
+            i += 1;
+        } else {
+            out.push(inner_step.expect("an inner step remains"));
+            j += 1;
+        }
+    }
+}
+
+/// Triangulates a convex polygon (points on the reference triangle's boundary, some collinear)
+/// by cutting, each time, the ear with the largest minimum angle among those positively
+/// oriented and holding no other vertex, not even on their new diagonal.
+fn clip_ears(polygon: &mut Vec<u32>, at: &dyn Fn(u32) -> [f64; 2], out: &mut Vec<[u32; 3]>) {
+    while polygon.len() >= 3 {
+        let n = polygon.len();
+        let best = (0..n)
+            .filter_map(|v| {
+                let t = [polygon[(v + n - 1) % n], polygon[v], polygon[(v + 1) % n]];
+                let [a, b, c] = t.map(at);
+                let empty = polygon
+                    .iter()
+                    .all(|&x| t.contains(&x) || !inside(at(x), a, b, c));
+                (orient(a, b, c) > 1e-12 && empty).then(|| (min_angle(a, b, c), v, t))
+            })
+            .max_by(|x, y| x.0.total_cmp(&y.0).then(y.1.cmp(&x.1)));
+        let Some((_, v, t)) = best else { break };
+        out.push(t);
+        polygon.remove(v);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashMap;
+
+    /// Every pattern tiles the reference triangle: triangles positively oriented, their areas
+    /// summing to the whole, every inner edge shared by exactly two triangles in opposite
+    /// directions and every boundary segment used once; and the worst minimum angle is kept.
+    fn check(key: PatternKey) -> f64 {
+        let pattern = Pattern::new(key);
+        let at = |p: u32| domain(pattern.bary(p));
+        assert_eq!(
+            pattern.triangles.len() as u64,
+            key.triangle_count(),
+            "{key:?}"
+        );
+        let mut area = 0.0;
+        let mut worst = f64::MAX;
+        let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
+        for t in &pattern.triangles {
+            let [a, b, c] = t.map(at);
+            let o = orient(a, b, c);
+            assert!(o > 0.0, "{key:?}: {t:?} not positive");
+            area += o / 2.0;
+            worst = worst.min(min_angle(a, b, c));
+            for s in 0..3 {
+                *directed.entry((t[s], t[(s + 1) % 3])).or_default() += 1;
+            }
+        }
+        let whole = (0.75f64).sqrt() / 2.0;
+        assert!(
+            (area - whole).abs() < 1e-12 * whole.max(1.0),
+            "{key:?}: area {area}"
+        );
+        let boundary: usize = key.edges.iter().map(|&e| e as usize).sum();
+        let mut unpaired = 0;
+        for (&(a, b), &count) in &directed {
+            assert_eq!(count, 1, "{key:?}: edge {a}-{b} used {count} times");
+            if !directed.contains_key(&(b, a)) {
+                unpaired += 1;
+            }
+        }
+        assert_eq!(unpaired, boundary, "{key:?}: boundary segments");
+        let used: std::collections::HashSet<u32> =
+            pattern.triangles.iter().flatten().copied().collect();
+        assert_eq!(
+            used.len(),
+            pattern.lattice.len(),
+            "{key:?}: every point used"
+        );
+        worst
+    }
+
+    #[test]
+    fn uniform_counts_give_the_uniform_lattice() {
+        for m in 1..=12 {
+            let key = PatternKey {
+                edges: [m; 3],
+                inner: m,
+            };
+            let worst = check(key);
+            assert!((worst - std::f64::consts::FRAC_PI_3).abs() < 1e-9, "{m}");
+        }
+    }
+
+    #[test]
+    fn every_balanced_combination_tiles_the_triangle_with_well_shaped_triangles() {
+        // The combinations `counts.rs` produces: M at least every edge, every edge at least
+        // ⌈M/2⌉.
+        let mut worst = f64::MAX;
+        for m in 1..=24u32 {
+            let low = m.div_ceil(2);
+            for a in low..=m {
+                for b in low..=m {
+                    for c in low..=m {
+                        let angle = check(PatternKey {
+                            edges: [a, b, c],
+                            inner: m,
+                        });
+                        worst = worst.min(angle);
+                    }
+                }
+            }
+        }
+        // Measured: 30.00° (the uniform lattice has 60°; a sliver would be a few degrees).
+        let degrees = worst.to_degrees();
+        println!("worst minimum angle over balanced patterns: {degrees:.2}°");
+        assert!(degrees > 29.99, "worst minimum angle {degrees}°");
+    }
+}
