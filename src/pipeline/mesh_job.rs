@@ -206,7 +206,14 @@ pub fn smooth_mesh(
     let attr_start = Instant::now();
     let mut primitives = Vec::with_capacity(prepared.len());
     let targets = morph::targets(
-        &mesh, &topo, &params.effective, &prepared, &groups, &density, options, &remaps,
+        &mesh,
+        &topo,
+        &params.effective,
+        &prepared,
+        &groups,
+        &density,
+        options,
+        &remaps,
     );
     for (k, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
         report.primitives.push(PrimitiveReport {

@@ -15,7 +15,7 @@
 //!   below both the line and `h` (so the region never leaves its subdomain), which makes the
 //!   surface curvature-continuous everywhere but at the vertices.
 //!
-//! Measured (`tests/surface_continuity.rs`): the normal-curvature jump × L along the edge
+//! Measured (`tests/integration/surface_continuity.rs`): the normal-curvature jump × L along the edge
 //! across the four switch lines of every interior edge, halfway into the region, at distance eps
 //! either side of the line (max over the mesh):
 //!

@@ -32,7 +32,7 @@ pub const PROBE_LEVEL: u32 = 6;
 
 /// Margin on the predicted error: the probe sees the curvature at its own points only, and
 /// the transition rings hold triangles up to twice as long as the inner lattice's. Measured
-/// on the icosphere, torus, bumpy sphere, height field and domed plate (`tests/tessellate_adaptive.rs`),
+/// on the icosphere, torus, bumpy sphere, height field and domed plate (`tests/integration/tessellate_adaptive.rs`),
 /// the error reached without it is up to 4% over the target.
 pub const MARGIN: f64 = 1.25;
 

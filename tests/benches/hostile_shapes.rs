@@ -10,7 +10,7 @@ use g2tess::options::Options;
 use g2tess::pipeline::process_document;
 use std::path::Path;
 
-#[path = "../hostile/mod.rs"]
+#[path = "../integration/hostile.rs"]
 mod hostile;
 
 /// Positions and indices of `n` triangles of one kind.

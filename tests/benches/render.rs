@@ -14,7 +14,7 @@ use g2tess::topology::Topology;
 use glam::{Mat4, Vec3};
 use std::hint::black_box;
 
-#[path = "../support/mod.rs"]
+#[path = "../integration/support.rs"]
 mod support;
 
 const LEVEL: u32 = 22;

@@ -7,7 +7,7 @@
 //! `evaluate`, and whole lattices through `evaluate_lattice` as the tessellator does (Coons also
 //! with per-triangle faired λ, where lattice weights are not shared).
 
-#[path = "../support/mod.rs"]
+#[path = "../integration/support.rs"]
 mod support;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};

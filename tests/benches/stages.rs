@@ -19,7 +19,7 @@ use g2tess::topology::Topology;
 use std::hint::black_box;
 use std::path::Path;
 
-#[path = "../support/mod.rs"]
+#[path = "../integration/support.rs"]
 mod support;
 
 const LEVEL: u32 = 16;

@@ -9,7 +9,7 @@ use g2tess::surface::{lattice_bary, lattice_len, G2Surface, PnSurface, Profile, 
 use g2tess::topology::Topology;
 use std::hint::black_box;
 
-#[path = "../support/mod.rs"]
+#[path = "../integration/support.rs"]
 mod support;
 
 const LEVEL: u32 = 16;

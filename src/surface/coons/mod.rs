@@ -18,7 +18,7 @@
 //!   over the other triangle (seed 000's neighbour map, [`compose`]); needs no plane and has no
 //!   singular setup.
 //!
-//! The default is the Foley–Opitz one because it is measurably better (`tests/schemes_shape.rs`,
+//! The default is the Foley–Opitz one because it is measurably better (`tests/integration/schemes_shape.rs`,
 //! `benches/schemes.rs`): closer to the exact surface on every mesh measured (sphere sampled by
 //! an icosahedron: max distance 0.0134 against 0.0597; torus 10×10: 0.0109 against 0.0239, where
 //! PN gives 0.0584 and 0.0117), and cheaper to build and to evaluate. `PnAverage` is kept for
@@ -41,11 +41,11 @@
 //! faired λ are mostly unique, and a triangle whose λ no other triangle has computes its
 //! coefficients point by point. `evaluate` computes the same coefficients at its point and goes
 //! through the same combination, so lattice and `evaluate` agree bit for bit
-//! (`tests/schemes_lattice.rs`). Per point with its normal (`benches/schemes.rs`, bumpy sphere,
+//! (`tests/integration/schemes_lattice.rs`). Per point with its normal (`benches/schemes.rs`, bumpy sphere,
 //! level 16): 0.17 µs on a lattice with one λ, 0.4 µs with faired λ, 1.1 µs alone (before the
 //! coefficients were shared, every point cost 1.3 µs; PN: 0.07–0.09 µs).
 //!
-//! Measured (`tests/schemes_continuity.rs`): gap ≤ 3e-15 L and normal jump ≤ 7e-13° across
+//! Measured (`tests/integration/schemes_continuity.rs`): gap ≤ 3e-15 L and normal jump ≤ 7e-13° across
 //! every smooth edge of the generated meshes (analytic normals; 2e-6° by differences).
 
 pub mod dual;

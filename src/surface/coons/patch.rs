@@ -18,7 +18,7 @@
 //! f = ½(A1 + A2 + A3 − q) − ½(κ1 E1 + κ2 E2 + κ3 E3)                 (Eq. 11, corrected)
 //! ```
 //!
-//! Corrections to the paper, each shown wrong by `tests/schemes_typos.rs`:
+//! Corrections to the paper, each shown wrong by `tests/integration/schemes_typos.rs`:
 //! - Eq. 11 prints `f = ½[…] − q − s`; `q` belongs inside the bracket as in Eq. 3, else the patch
 //!   does not even interpolate its boundary curves.
 //! - Eq. 9's coefficients `μ3 r3u + (1−μ3) r2u` omit the derivative of the blend itself: the

@@ -2,7 +2,7 @@
 //! `p` and `q` of two cubic patches over a plane, from their boundary control points.
 //!
 //! It deliberately knows nothing of meshes, planes or blending: labelled points in, two points
-//! out. Corrected as follows (each shown wrong by `tests/schemes_typos.rs`):
+//! out. Corrected as follows (each shown wrong by `tests/integration/schemes_typos.rs`):
 //! - `(r, s, t)` are the barycentrics of the neighbour's apex `Y` (the paper's `c003`) with
 //!   respect to `(b300, b030, b003)`, not `(b003, b030, b300)` as printed: the blossom derivation
 //!   of the printed `p2` formula ties `r` to `b300`, `s` to `b030` and `t` to the apex `b003`.

@@ -28,9 +28,9 @@
 //! lattice's coefficients are computed once per level ([`patch::Weights`]) and every triangle
 //! combines them with its 18 distinct control points: 54 vector multiply-adds per point.
 //! `evaluate` computes the same coefficients at its point and goes through the same combination,
-//! so lattice and `evaluate` agree bit for bit (`tests/schemes_lattice.rs`).
+//! so lattice and `evaluate` agree bit for bit (`tests/integration/schemes_lattice.rs`).
 //!
-//! Measured (`tests/schemes_continuity.rs`, `tests/schemes_shape.rs`, `benches/schemes.rs`): gap
+//! Measured (`tests/integration/schemes_continuity.rs`, `tests/integration/schemes_shape.rs`, `benches/schemes.rs`): gap
 //! ≤ 2e-15 L and normal jump ≤ 4e-13° across every smooth edge of the generated meshes; per
 //! point with its normal 0.09 µs on a lattice (PN 0.07–0.09 µs) and 0.16 µs alone, as before;
 //! distance to the exact sphere sampled by an icosahedron 0.0131 (PN 0.0584).

@@ -1,0 +1,92 @@
+//! Tolerance runs on the real fixtures: every one that processes at a level also processes to
+//! a relative tolerance, with morph targets, skins and attributes carried; the output passes
+//! the validator where the input does, is the same at one and two threads, and is smaller than
+//! the uniform level its counts are capped at.
+
+use crate::corpus;
+
+use std::path::{Path, PathBuf};
+
+use g2tess::options::Options;
+use g2tess::pipeline::process_file;
+
+fn adaptive() -> Options {
+    let mut options = Options::default();
+    options.relative_tolerance = 0.002;
+    options.max_segments = 8;
+    options.report_figures = true;
+    options
+}
+
+fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+#[test]
+fn real_fixtures_to_a_tolerance_are_valid_deterministic_and_capped() {
+    let Some(root) = corpus::fixtures_real() else {
+        println!("fixtures-real not found: skipped");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let names = [
+        "Duck",
+        "Suzanne",
+        "Fox",
+        "AnimatedMorphCube",
+        "MorphPrimitivesTest",
+        "SkinnedCylinder",
+        "BoxTextured",
+        "MultiPrimCustomAttribute",
+    ];
+    let mut pairs: Vec<(PathBuf, PathBuf)> = Vec::new();
+    for name in names {
+        let Some(input) = corpus::gltf_files(&root.join("valid").join(name))
+            .into_iter()
+            .next()
+        else {
+            continue;
+        };
+        let out = |tag: &str| dir.path().join(format!("{name}.{tag}.glb"));
+        let one = in_pool(1, || process_file(&input, &out("1"), &adaptive()))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let two = in_pool(2, || process_file(&input, &out("2"), &adaptive())).unwrap();
+        assert_eq!(
+            std::fs::read(out("1")).unwrap(),
+            std::fs::read(out("2")).unwrap(),
+            "{name}: bytes differ between 1 and 2 threads"
+        );
+        assert_eq!(one.triangles_out, two.triangles_out);
+        // At most the uniform level of the cap, and every mesh reports its figures.
+        assert!(one.triangles_out <= one.triangles_in * 64, "{name}");
+        for mesh in &one.meshes {
+            let figures = mesh.adaptive.as_ref().expect("adaptive figures");
+            assert!(figures.max_segments <= 8, "{name}");
+            assert!(figures.chord_error.is_some(), "{name}");
+        }
+        pairs.push((input, out("1")));
+    }
+    assert!(pairs.len() >= 6, "only {} fixtures found", pairs.len());
+    let inputs: Vec<&Path> = pairs.iter().map(|(i, _)| i.as_path()).collect();
+    let outputs: Vec<&Path> = pairs.iter().map(|(_, o)| o.as_path()).collect();
+    let (Some(before), Some(after)) = (corpus::validate(&inputs), corpus::validate(&outputs))
+    else {
+        println!("validator not installed: validation skipped");
+        return;
+    };
+    for (input, output) in &pairs {
+        if before[input].errors == 0 {
+            assert_eq!(
+                after[output].errors,
+                0,
+                "{}: {:?}",
+                input.display(),
+                after[output].codes
+            );
+        }
+    }
+}

@@ -1,0 +1,182 @@
+//! Continuity of the G² surface, measured on generated meshes: G0, G1 and G2 across edges for
+//! h > 0 and their failure for plain PN (h = 0), the paper's profile against the C² profile
+//! inside the blending regions, and analytic against finite-difference normals.
+
+use crate::support::*;
+use g2tess::continuity::{self, angle_deg, normal_curvature, Sampling};
+use g2tess::surface::{G2Surface, PnSurface, Profile, Surface, H_MAX};
+use g2tess::topology::{EdgeKind, Topology};
+
+/// Positions are sums of ten terms of size ~|p| ≤ 2L: a gap above 1e-13·L is not rounding.
+const GAP_TOL: f64 = 1e-13;
+
+fn report(mesh: &g2tess::mesh::TriMesh, h: f64, profile: Profile) -> continuity::ContinuityReport {
+    let topo = Topology::build(mesh);
+    let s = G2Surface::new(mesh, &topo, &h_all(&topo, h), profile);
+    continuity::measure(&s, &topo, &Sampling::default())
+}
+
+/// Below this (× L) a curvature jump is rounding: normals carry ~1e-16 error, differenced over
+/// `2·step = eps/2`, so at eps = 1e-4 the estimate is good to ~1e-11; 1e-9 leaves a margin.
+const CURVATURE_FLOOR: f64 = 1e-9;
+
+/// Ratio of the curvature jump (max) from one eps to the next, ten times smaller. A jump that is
+/// already below [`CURVATURE_FLOOR`] counts as falling by 10 (symmetric meshes such as the
+/// icosahedron have no jump at all to measure).
+fn decay(r: &continuity::ContinuityReport) -> [f64; 2] {
+    let j: Vec<f64> = r.curvature_jump.iter().map(|c| c.jump.max).collect();
+    let ratio = |a: f64, b: f64| if a <= CURVATURE_FLOOR { 10.0 } else { a / b };
+    [ratio(j[0], j[1]), ratio(j[1], j[2])]
+}
+
+#[test]
+fn blended_surface_is_g0_g1_g2_across_edges() {
+    for (name, mesh) in smooth_meshes() {
+        for h in [0.106, 0.212, H_MAX] {
+            for profile in [Profile::Paper, Profile::C2] {
+                let r = report(&mesh, h, profile);
+                assert!(r.edges > 0);
+                let ctx = format!("{name} h={h} {profile:?}: {r:?}");
+                assert!(r.gap.max <= GAP_TOL, "G0 {ctx}");
+                assert!(r.normal_jump_deg.max < 1e-6, "G1 {ctx}");
+                let [a, b] = decay(&r);
+                let jumps: Vec<f64> = r.curvature_jump.iter().map(|c| c.jump.max).collect();
+                println!(
+                    "{name:12} h={h:.3} {profile:5?}: normal jump {:.1e}°, curvature jump x L {}",
+                    r.normal_jump_deg.max,
+                    jumps
+                        .iter()
+                        .map(|j| format!("{j:.2e}"))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                );
+                assert!(a >= 5.0 && b >= 5.0, "G2 decay {a:.2} {b:.2} {ctx}");
+            }
+        }
+    }
+}
+
+#[test]
+fn plain_pn_is_g0_but_not_g1_or_g2() {
+    let mesh = bumpy_sphere();
+    let topo = Topology::build(&mesh);
+    let r = continuity::measure(&PnSurface::new(&mesh, &topo), &topo, &Sampling::default());
+    assert!(r.gap.max <= GAP_TOL, "{r:?}");
+    assert!(r.normal_jump_deg.max > 1.0, "{r:?}");
+    let [a, b] = decay(&r);
+    assert!(a < 2.0 && b < 2.0, "curvature jump must not fall: {r:?}");
+}
+
+#[test]
+fn split_normals_stay_watertight_at_h_zero_and_close_for_h_above() {
+    let mesh = split_normals(&bumpy_sphere(), 0.5);
+    let topo = Topology::build(&mesh);
+    assert!(topo
+        .edges
+        .iter()
+        .all(|e| e.kind == EdgeKind::Interior && e.split_normals));
+    // h = 0: the edge curves are averaged (PN-AEN); positions agree, normals do not.
+    let r = continuity::measure(&PnSurface::new(&mesh, &topo), &topo, &Sampling::default());
+    assert!(r.gap.max <= GAP_TOL, "{r:?}");
+    assert!(r.normal_jump_deg.max > 1.0, "{r:?}");
+    // h > 0: the blend closes the crease and is G2 again.
+    for profile in [Profile::Paper, Profile::C2] {
+        let r = report(&mesh, 0.212, profile);
+        assert!(
+            r.gap.max <= GAP_TOL && r.normal_jump_deg.max < 1e-6,
+            "{r:?}"
+        );
+        let [a, b] = decay(&r);
+        assert!(a >= 5.0 && b >= 5.0, "{a} {b} {r:?}");
+    }
+}
+
+/// Curvature jump × L along the edge direction across the four profile switch lines of every
+/// interior edge, halfway into the blending region, at distance `eps` either side of the line.
+fn switch_line_jump(mesh: &g2tess::mesh::TriMesh, h: f64, profile: Profile, eps: f64) -> f64 {
+    let topo = Topology::build(mesh);
+    let s = G2Surface::new(mesh, &topo, &h_all(&topo, h), profile);
+    let l = continuity::mean_edge_length(&topo);
+    let mut worst: f64 = 0.0;
+    for e in topo.edges.iter().filter(|e| e.kind == EdgeKind::Interior) {
+        let (t, k) = (e.tris[0].0 .0 as usize, e.tris[0].1 as usize);
+        let (a, b) = ((k + 2) % 3, (k + 1) % 3);
+        for sw in Profile::switch_points(h) {
+            // s runs from corner b (s = 0) to corner a (s = √2); r(sw) is the same for both
+            // profiles at the switch points.
+            let sn = sw.min(std::f64::consts::SQRT_2 - sw);
+            let r = profile.radius(sn, h).0;
+            let at = |s: f64| {
+                let mut l = [0.0; 3];
+                l[k] = 0.5 * r / 1.5f64.sqrt();
+                l[a] = (s * std::f64::consts::SQRT_2 - l[k]) / 2.0;
+                l[b] = 1.0 - l[a] - l[k];
+                l
+            };
+            let mut dir = [0.0; 3];
+            dir[a] = std::f64::consts::FRAC_1_SQRT_2;
+            dir[b] = -std::f64::consts::FRAC_1_SQRT_2;
+            let k1 = normal_curvature(&s, t, at(sw - eps), dir, eps / 4.0);
+            let k2 = normal_curvature(&s, t, at(sw + eps), dir, eps / 4.0);
+            worst = worst.max((k1 - k2).abs() * l);
+        }
+    }
+    worst
+}
+
+#[test]
+fn c2_profile_removes_the_curvature_jump_inside_regions_and_paper_profile_does_not() {
+    for (name, mesh) in [("cube", cube()), ("bumpy_sphere", bumpy_sphere())] {
+        for h in [0.106, 0.212] {
+            let jumps = |p| [1e-2, 1e-3, 1e-4].map(|e| switch_line_jump(&mesh, h, p, e));
+            let paper = jumps(Profile::Paper);
+            let c2 = jumps(Profile::C2);
+            println!("{name} h={h}: paper {paper:?}  c2 {c2:?}");
+            assert!(
+                paper[1] / paper[2] < 2.0 && paper[2] > 1e-3,
+                "paper {name} {h}: {paper:?}"
+            );
+            assert!(
+                c2[0] / c2[1] >= 5.0 && c2[1] / c2[2] >= 5.0,
+                "c2 {name} {h}: {c2:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn analytic_normals_match_central_differences() {
+    let mut rng = Lcg(7);
+    let fd_step = 1e-6;
+    let mut worst: f64 = 0.0;
+    for (name, mesh) in smooth_meshes()
+        .into_iter()
+        .chain([("split", split_normals(&bumpy_sphere(), 0.5))])
+    {
+        let topo = Topology::build(&mesh);
+        for h in [0.0, 0.106, 0.212, H_MAX] {
+            for profile in [Profile::Paper, Profile::C2] {
+                let s = G2Surface::new(&mesh, &topo, &h_all(&topo, h), profile);
+                for _ in 0..200 {
+                    let t = (rng.next() * mesh.triangles.len() as f64) as usize;
+                    let l = rng.bary(0.01);
+                    let p = |du: f64, dv: f64| {
+                        s.evaluate(t, [l[0] + du, l[1] + dv, l[2] - du - dv])
+                            .position
+                    };
+                    let su = (p(fd_step, 0.0) - p(-fd_step, 0.0)) / (2.0 * fd_step);
+                    let sv = (p(0.0, fd_step) - p(0.0, -fd_step)) / (2.0 * fd_step);
+                    let n = s.evaluate(t, l).normal;
+                    let fd = su.cross(sv).normalize();
+                    let angle = angle_deg(n, fd).min(angle_deg(n, -fd));
+                    worst = worst.max(angle);
+                    assert!(
+                        angle < 1e-5,
+                        "{name} h={h} {profile:?} tri {t} at {l:?}: {angle}°"
+                    );
+                }
+            }
+        }
+    }
+    println!("worst analytic vs FD normal angle: {worst:.2e}°");
+}

@@ -1,0 +1,194 @@
+//! The G² surface's fixed points: h = 0 is the PN triangle of Eq. 1–2, flat stays flat, corners
+//! are the input vertices, lattice evaluation equals point evaluation, and reordering or
+//! flipping triangles does not move the surface.
+
+use crate::support::*;
+use g2tess::surface::{lattice_bary, G2Surface, Nets, PnSurface, Profile, Surface, H_MAX};
+use g2tess::topology::Topology;
+use glam::DVec3;
+
+/// Eq. 1–2 written out directly (Vlachos et al. 2001, E over all six edge points).
+fn pn_reference(p: [DVec3; 3], n: [DVec3; 3], [u, v, w]: [f64; 3]) -> DVec3 {
+    let b = |i: usize, j: usize| (2.0 * p[i] + p[j] - (p[j] - p[i]).dot(n[i]) * n[i]) / 3.0;
+    let (b210, b120, b021, b012, b102, b201) =
+        (b(0, 1), b(1, 0), b(1, 2), b(2, 1), b(2, 0), b(0, 2));
+    let e = (b210 + b120 + b021 + b012 + b102 + b201) / 6.0;
+    let b111 = e + (e - (p[0] + p[1] + p[2]) / 3.0) / 2.0;
+    p[0] * u * u * u
+        + p[1] * v * v * v
+        + p[2] * w * w * w
+        + 3.0 * (b210 * u * u * v + b120 * u * v * v + b021 * v * v * w)
+        + 3.0 * (b012 * v * w * w + b102 * u * w * w + b201 * u * u * w)
+        + 6.0 * b111 * u * v * w
+}
+
+/// On the paper's nets; on the round ones `PnSurface` is the G² surface at h = 0 just the same.
+#[test]
+fn h_zero_is_the_pn_triangle() {
+    let mut rng = Lcg(3);
+    for (name, mesh) in smooth_meshes() {
+        let topo = Topology::build(&mesh);
+        let h0 = h_all(&topo, 0.0);
+        let pn = PnSurface::with_nets(&mesh, &topo, Nets::Paper);
+        let g2 = G2Surface::with_nets(&mesh, &topo, &h0, Profile::Paper, Nets::Paper);
+        let (pn_round, g2_round) = (
+            PnSurface::new(&mesh, &topo),
+            G2Surface::new(&mesh, &topo, &h0, Profile::Paper),
+        );
+        for t in 0..mesh.triangles.len() {
+            let c = mesh.triangles[t].map(|i| i as usize);
+            for _ in 0..10 {
+                let l = rng.bary(0.0);
+                let want =
+                    pn_reference(c.map(|i| mesh.positions[i]), c.map(|i| mesh.normals[i]), l);
+                let got = pn.evaluate(t, l);
+                // Same sums in another order: a few ulps of |p| ≤ 2.
+                assert!((got.position - want).length() < 1e-14, "{name} tri {t}");
+                assert_eq!(
+                    got,
+                    g2.evaluate(t, l),
+                    "{name}: PnSurface is the G² surface at h = 0"
+                );
+                assert_eq!(pn_round.evaluate(t, l), g2_round.evaluate(t, l), "{name}");
+            }
+        }
+    }
+}
+
+#[test]
+fn flat_mesh_with_equal_normals_stays_exactly_flat() {
+    let mesh = flat_grid(4);
+    let topo = Topology::build(&mesh);
+    let mut rng = Lcg(5);
+    let h: Vec<f64> = topo.edges.iter().map(|_| rng.next() * H_MAX).collect();
+    for profile in [Profile::Paper, Profile::C2] {
+        let s = G2Surface::new(&mesh, &topo, &h, profile);
+        for t in 0..mesh.triangles.len() {
+            let mut out = Vec::new();
+            s.evaluate_lattice(t, 9, &mut out);
+            for _ in 0..20 {
+                out.push(s.evaluate(t, rng.bary(0.0)));
+            }
+            for p in out {
+                assert_eq!(p.position.z, 0.0);
+                assert_eq!(p.normal, DVec3::Z);
+            }
+        }
+    }
+}
+
+#[test]
+fn corners_are_the_input_vertices_bit_for_bit() {
+    let mesh = split_normals(&bumpy_sphere(), 0.5);
+    let topo = Topology::build(&mesh);
+    for h in [0.0, 0.212] {
+        let s = G2Surface::new(&mesh, &topo, &h_all(&topo, h), Profile::C2);
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for c in 0..3 {
+                let mut l = [0.0; 3];
+                l[c] = 1.0;
+                let v = tri[c] as usize;
+                let p = s.evaluate(t, l);
+                assert_eq!(p.position, mesh.positions[v]);
+                assert_eq!(p.normal, mesh.normals[v].normalize());
+            }
+        }
+    }
+}
+
+#[test]
+fn lattice_evaluation_equals_point_evaluation() {
+    let mesh = bumpy_sphere();
+    let topo = Topology::build(&mesh);
+    let mut rng = Lcg(11);
+    let h: Vec<f64> = topo
+        .edges
+        .iter()
+        .map(|_| (rng.next() * 4.0).floor() * 0.1)
+        .collect();
+    let s = G2Surface::new(&mesh, &topo, &h, Profile::C2);
+    for level in [1, 4, 7] {
+        for t in 0..mesh.triangles.len() {
+            let mut out = Vec::new();
+            s.evaluate_lattice(t, level, &mut out);
+            let mut idx = 0;
+            for j in 0..=level {
+                for i in 0..=level - j {
+                    assert_eq!(out[idx], s.evaluate(t, lattice_bary(level, i, j)));
+                    idx += 1;
+                }
+            }
+            assert_eq!(idx, out.len());
+        }
+    }
+}
+
+#[test]
+fn reordering_corners_or_flipping_triangles_does_not_move_the_surface() {
+    let mut rng = Lcg(13);
+    for (name, mesh) in [
+        ("bumpy_sphere", bumpy_sphere()),
+        ("split", split_normals(&bumpy_sphere(), 0.5)),
+    ] {
+        let topo = Topology::build(&mesh);
+        let scale = mesh
+            .positions
+            .iter()
+            .map(|p| p.length())
+            .fold(0.0, f64::max);
+        for (reversed, seed) in [(0.0, 1), (0.3, 2)] {
+            let re = reorder(&mesh, reversed, seed);
+            let topo2 = Topology::build(&re.mesh);
+            assert_eq!(topo2.edges.len(), topo.edges.len());
+            // The same h per welded edge: look each edge up by its end positions.
+            let h_of = |topo: &Topology, e: &g2tess::topology::Edge| {
+                let [a, b] = e.verts.map(|v| topo.welded_positions[v.0 as usize]);
+                ((a.x + b.x) * 7.0 + (a.y + b.y) * 3.0 + (a.z + b.z))
+                    .sin()
+                    .abs()
+                    * H_MAX
+            };
+            let h1: Vec<f64> = topo.edges.iter().map(|e| h_of(&topo, e)).collect();
+            let h2: Vec<f64> = topo2.edges.iter().map(|e| h_of(&topo2, e)).collect();
+            for profile in [Profile::Paper, Profile::C2] {
+                let s1 = G2Surface::new(&mesh, &topo, &h1, profile);
+                let s2 = G2Surface::new(&re.mesh, &topo2, &h2, profile);
+                let mut worst: f64 = 0.0;
+                for t in 0..mesh.triangles.len() {
+                    for _ in 0..10 {
+                        let l = rng.bary(0.0);
+                        let (a, b) = (s1.evaluate(t, l), s2.evaluate(t, re.bary(t, l)));
+                        worst = worst.max((a.position - b.position).length() / scale);
+                        assert!(a.normal.dot(b.normal) > 1.0 - 1e-12, "{name} normal");
+                    }
+                }
+                println!("{name} reversed={reversed} {profile:?}: max relative position change {worst:.1e}");
+                assert!(worst < 1e-12, "{name} reversed={reversed}: {worst}");
+            }
+        }
+    }
+}
+
+#[test]
+fn h_is_clamped_and_unblendable_edges_are_reported() {
+    let mesh = height_field(3);
+    let topo = Topology::build(&mesh);
+    let s = G2Surface::new(&mesh, &topo, &h_all(&topo, 5.0), Profile::C2);
+    let boundary = topo
+        .edges
+        .iter()
+        .filter(|e| e.kind == g2tess::topology::EdgeKind::Boundary)
+        .count();
+    for (e, &h) in topo.edges.iter().zip(s.effective_h()) {
+        let want = if e.kind == g2tess::topology::EdgeKind::Interior {
+            H_MAX
+        } else {
+            0.0
+        };
+        assert_eq!(h, want);
+    }
+    assert!(matches!(
+        s.warnings(),
+        [g2tess::topology::Warning::BlendIgnored { kind: g2tess::topology::EdgeKind::Boundary, edges, .. }] if *edges == boundary
+    ));
+}

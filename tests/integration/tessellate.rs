@@ -1,0 +1,238 @@
+//! Uniform tessellation on generated meshes: counts, watertightness, identity at level 1,
+//! seams kept where the input had them, and agreement with the surface.
+
+// One group is one output primitive; a single range is the common case, not a mistake.
+#![allow(clippy::single_range_in_vec_init)]
+
+use std::collections::HashMap;
+
+use crate::support::*;
+use g2tess::mesh::TriMesh;
+use g2tess::surface::{G2Surface, Profile, Surface};
+use g2tess::tessellate::{tessellate, DenseMesh, VertexSource};
+use g2tess::topology::Topology;
+use glam::DVec3;
+
+fn run(mesh: &TriMesh, h: f64, level: u32) -> (Topology, Vec<f64>, DenseMesh) {
+    let topo = Topology::build(mesh);
+    let hs = h_all(&topo, h);
+    let surface = G2Surface::new(mesh, &topo, &hs, Profile::C2);
+    let dense = tessellate(
+        mesh,
+        &topo,
+        &hs,
+        &surface,
+        level,
+        &[0..mesh.triangles.len()],
+    )
+    .pop()
+    .unwrap();
+    (topo, hs, dense)
+}
+
+/// Number of edges that only one triangle uses, after welding vertices by exact position.
+fn boundary_edges(positions: &[[f32; 3]], indices: &[u32]) -> usize {
+    let mut welded: HashMap<[u32; 3], u32> = HashMap::new();
+    let ids: Vec<u32> = positions
+        .iter()
+        .map(|p| {
+            let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+            let next = welded.len() as u32;
+            *welded.entry(key).or_insert(next)
+        })
+        .collect();
+    let mut uses: HashMap<(u32, u32), usize> = HashMap::new();
+    for t in indices.chunks(3) {
+        for k in 0..3 {
+            let (a, b) = (ids[t[k] as usize], ids[t[(k + 1) % 3] as usize]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    uses.values().filter(|&&u| u == 1).count()
+}
+
+fn input_boundary_edges(mesh: &TriMesh) -> usize {
+    let positions: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| p.as_vec3().to_array())
+        .collect();
+    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    boundary_edges(&positions, &indices)
+}
+
+#[test]
+fn every_triangle_becomes_level_squared_triangles() {
+    let mesh = icosahedron();
+    for level in 1..=6 {
+        let (_, _, dense) = run(&mesh, 0.2, level);
+        assert_eq!(
+            dense.indices.len() / 3,
+            mesh.triangles.len() * (level * level) as usize
+        );
+        // A closed welded mesh shares every edge and corner sample: V - E + F = 2.
+        let v = dense.positions.len() as i64;
+        let f = (dense.indices.len() / 3) as i64;
+        assert_eq!(v - 3 * f / 2 + f, 2, "level {level}");
+    }
+}
+
+#[test]
+fn output_is_watertight_wherever_the_input_was() {
+    let cases: Vec<(&str, TriMesh)> = vec![
+        ("icosahedron", icosahedron()),
+        ("cube", cube()),
+        ("bumpy", bumpy_sphere()),
+        ("height field", height_field(5)),
+        ("split normals", split_normals(&bumpy_sphere(), 0.3)),
+        ("shuffled soup", reorder(&bumpy_sphere(), 0.3, 7).mesh),
+    ];
+    for (name, mesh) in &cases {
+        let before = input_boundary_edges(mesh);
+        for h in [0.0, 0.2] {
+            for level in [2, 5] {
+                let (_, _, dense) = run(mesh, h, level);
+                let after = boundary_edges(&dense.positions, &dense.indices);
+                assert_eq!(
+                    after,
+                    before * level as usize,
+                    "{name}, h = {h}, level {level}: new boundary edges"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn level_one_at_h_zero_is_the_identity() {
+    let mesh = bumpy_sphere();
+    let (_, _, dense) = run(&mesh, 0.0, 1);
+    assert_eq!(dense.positions.len(), mesh.positions.len());
+    let mut expected: Vec<[[u32; 3]; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                mesh.positions[v as usize]
+                    .as_vec3()
+                    .to_array()
+                    .map(f32::to_bits)
+            })
+        })
+        .collect();
+    let mut got: Vec<[[u32; 3]; 3]> = dense
+        .indices
+        .chunks(3)
+        .map(|t| [0, 1, 2].map(|k| dense.positions[t[k] as usize].map(f32::to_bits)))
+        .collect();
+    expected.sort();
+    got.sort();
+    assert_eq!(got, expected);
+}
+
+#[test]
+fn seams_in_the_input_stay_seams_with_identical_positions() {
+    // The split-normal soup has every vertex split; the output must split every shared edge
+    // sample too (one copy per side) while the positions agree bit for bit.
+    let mesh = split_normals(&icosahedron(), 0.3);
+    let level = 4;
+    let (_, _, dense) = run(&mesh, 0.15, level);
+    let per_tri = ((level + 1) * (level + 2) / 2) as usize;
+    assert_eq!(dense.positions.len(), mesh.triangles.len() * per_tri);
+    assert_eq!(boundary_edges(&dense.positions, &dense.indices), 0);
+}
+
+#[test]
+fn vertices_lie_on_the_surface_with_its_normals() {
+    let mesh = bumpy_sphere();
+    let (topo, hs, dense) = run(&mesh, 0.2, 3);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let scale = mean_edge(&mesh);
+    for (i, source) in dense.sources.iter().enumerate() {
+        let bary = source.bary().map(f64::from);
+        let p = surface.evaluate(source.tri as usize, bary);
+        let got = DVec3::from(dense.positions[i].map(f64::from));
+        // f32 storage and the f32 barycentrics of the source bound the difference.
+        assert!((got - p.position).length() < 1e-5 * scale, "vertex {i}");
+        let n = DVec3::from(dense.normals[i].map(f64::from));
+        assert!((n.length() - 1.0).abs() < 1e-6);
+        assert!(n.dot(p.normal) > 1.0 - 1e-6, "vertex {i}");
+    }
+}
+
+#[test]
+fn groups_split_the_output_but_not_the_surface() {
+    // Two groups over one closed mesh: each output is open, and together they close.
+    let mesh = icosahedron();
+    let topo = Topology::build(&mesh);
+    let hs = h_all(&topo, 0.2);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let half = mesh.triangles.len() / 2;
+    let parts = tessellate(
+        &mesh,
+        &topo,
+        &hs,
+        &surface,
+        4,
+        &[0..half, half..mesh.triangles.len()],
+    );
+    let mut positions = parts[0].positions.clone();
+    let mut indices = parts[0].indices.clone();
+    let offset = positions.len() as u32;
+    positions.extend_from_slice(&parts[1].positions);
+    indices.extend(parts[1].indices.iter().map(|i| i + offset));
+    assert!(boundary_edges(&parts[0].positions, &parts[0].indices) > 0);
+    assert_eq!(boundary_edges(&positions, &indices), 0);
+}
+
+/// A surface whose two sides of an edge disagree in the last digits, as any scheme may after
+/// rounding: the tessellator alone must keep the output watertight.
+struct Jittered<'a>(&'a dyn Surface);
+
+impl Surface for Jittered<'_> {
+    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> g2tess::surface::SurfacePoint {
+        let mut p = self.0.evaluate(tri, bary);
+        p.position += DVec3::splat(1e-6 * (tri % 7) as f64);
+        p
+    }
+}
+
+#[test]
+fn shared_samples_are_evaluated_once_even_if_the_sides_disagree() {
+    for mesh in [bumpy_sphere(), split_normals(&bumpy_sphere(), 0.3)] {
+        let topo = Topology::build(&mesh);
+        let hs = h_all(&topo, 0.1);
+        let inner = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+        let surface = Jittered(&inner);
+        let dense = tessellate(&mesh, &topo, &hs, &surface, 3, &[0..mesh.triangles.len()])
+            .pop()
+            .unwrap();
+        assert_eq!(boundary_edges(&dense.positions, &dense.indices), 0);
+    }
+}
+
+#[test]
+fn corner_tests_on_lattice_coordinates_agree_with_the_barycentrics() {
+    // The integer forms replace comparisons on the float barycentrics: they must pick the same
+    // corner (largest coordinate, ties to the lowest) at every point of every level.
+    for n in 1..=g2tess::options::MAX_LEVEL {
+        for j in 0..=n {
+            for i in 0..=n - j {
+                let s = VertexSource::lattice(7, n, i, j);
+                let b = s.bary();
+                let mut largest = 0;
+                for c in 1..3 {
+                    if b[c] > b[largest] {
+                        largest = c;
+                    }
+                }
+                assert_eq!(s.nearest_corner(), largest, "level {n}, ({i}, {j})");
+                assert_eq!(
+                    s.corner(),
+                    b.iter().position(|&x| x == 1.0),
+                    "level {n}, ({i}, {j})"
+                );
+            }
+        }
+    }
+}
