@@ -7,7 +7,7 @@ as the tolerance of an adaptive run; the table gives both triangle counts, the a
 own measured error, its worst triangle shape and both wall times (median of --runs).
 
 Usage: compare.py [--bin target/release/g2tess] [--levels 4,8,16] [--runs 3] ASSET...
-Generated spheres and tori: pass the .glb files written by /work/shared/bench/gen_mesh.py or
+Generated spheres and tori: pass the .glb files written by ../shared/bench/gen_mesh.py or
 any other mesh.
 """
 import argparse, json, os, statistics, subprocess, sys, tempfile, time
