@@ -4,6 +4,7 @@
 
 use std::collections::HashMap;
 
+use crate::support;
 use g2tess::render::shade::{shaded_colour, zebra_stripe, BACKGROUND};
 use g2tess::render::{sheet, Image, Mode, Scene, Settings, Subject, View};
 use glam::{Mat4, Vec3};
@@ -13,66 +14,12 @@ const BLACK: [u8; 3] = [24, 24, 28];
 
 /// The icosahedron subdivided `levels` times onto the unit sphere, normals = positions.
 fn icosphere(levels: u32) -> Scene {
-    let t = (1.0 + 5f32.sqrt()) / 2.0;
-    let mut positions: Vec<Vec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|p| Vec3::from(*p).normalize())
-    .collect();
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut next = Vec::with_capacity(triangles.len() * 4);
-        for [a, b, c] in triangles {
-            let mut m = |i: u32, j: u32| {
-                *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
-                    positions
-                        .push(((positions[i as usize] + positions[j as usize]) * 0.5).normalize());
-                    positions.len() as u32 - 1
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        triangles = next;
-    }
+    let mesh = (0..levels).fold(support::icosahedron(), |m, _| support::subdivide(&m));
+    let positions: Vec<Vec3> = mesh.positions.iter().map(|p| p.as_vec3()).collect();
     Scene {
         normals: positions.clone(),
         positions,
-        triangles,
+        triangles: mesh.triangles,
         instances: vec![(0, Mat4::IDENTITY)],
     }
 }
