@@ -17,6 +17,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+use super::blocks::{self, Block};
 use super::counts::SegmentCounts;
 use super::layout::GroupLayout;
 use super::transition::{Pattern, PatternKey};
@@ -138,27 +139,6 @@ impl Shared<'_> {
     }
 }
 
-/// One block of consecutive source triangles and the slices of the final buffers it owns.
-struct Block<'a> {
-    tris: Range<usize>,
-    vertex_base: usize,
-    index_base: usize,
-    positions: &'a mut [[f32; 3]],
-    normals: &'a mut [[f32; 3]],
-    sources: &'a mut [VertexSource],
-    indices: &'a mut [u32],
-}
-
-impl Block<'_> {
-    #[inline]
-    fn put(&mut self, slot: usize, position: [f32; 3], normal: [f32; 3], source: VertexSource) {
-        let at = slot - self.vertex_base;
-        self.positions[at] = position;
-        self.normals[at] = normal;
-        self.sources[at] = source;
-    }
-}
-
 fn tessellate_group(shared: &Shared<'_>, h: &[f64], range: Range<usize>) -> DenseMesh {
     let (mesh, topo, counts) = (shared.mesh, shared.topo, shared.counts);
     let layout = GroupLayout::with_counts(
@@ -188,39 +168,23 @@ fn tessellate_group(shared: &Shared<'_>, h: &[f64], range: Range<usize>) -> Dens
         sources: vec![VertexSource::lattice(0, 1, 0, 0); vertex_count],
         indices: vec![0; total],
     };
-    let mut blocks = Vec::new();
-    let (mut positions, mut normals, mut sources, mut indices) = (
-        &mut out.positions[..],
-        &mut out.normals[..],
-        &mut out.sources[..],
-        &mut out.indices[..],
-    );
+    // Blocks of whole source triangles up to about BLOCK_TRIANGLES output triangles.
+    let mut ranges = Vec::new();
     let mut start = 0;
     while start < range.len() {
-        // Whole source triangles up to about BLOCK_TRIANGLES output triangles.
         let mut end = start + 1;
         while end < range.len() && index_base[end + 1] - index_base[start] <= 3 * BLOCK_TRIANGLES {
             end += 1;
         }
-        let vertex_base = layout.base[start] as usize;
-        let vertices = layout.base[end] as usize - vertex_base;
-        let (p, rest_p) = std::mem::take(&mut positions).split_at_mut(vertices);
-        let (nr, rest_n) = std::mem::take(&mut normals).split_at_mut(vertices);
-        let (s, rest_s) = std::mem::take(&mut sources).split_at_mut(vertices);
-        let (i, rest_i) =
-            std::mem::take(&mut indices).split_at_mut(index_base[end] - index_base[start]);
-        (positions, normals, sources, indices) = (rest_p, rest_n, rest_s, rest_i);
-        blocks.push(Block {
-            tris: start..end,
-            vertex_base,
-            index_base: index_base[start],
-            positions: p,
-            normals: nr,
-            sources: s,
-            indices: i,
-        });
+        ranges.push(start..end);
         start = end;
     }
+    let blocks = blocks::split(
+        &mut out,
+        ranges,
+        |t| layout.base[t] as usize,
+        |t| index_base[t],
+    );
     blocks
         .into_par_iter()
         .for_each(|block| tessellate_block(shared, &layout, &index_base, range.start, block));

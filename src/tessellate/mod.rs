@@ -37,6 +37,7 @@
 //! little left to do (`optimize.rs` measures it).
 
 mod adaptive;
+mod blocks;
 mod chord;
 mod counts;
 mod lattice_edges;
@@ -47,6 +48,7 @@ mod transition;
 use crate::mesh::TriMesh;
 use crate::surface::{lattice_bary, LatticePart, Surface, SurfacePoint};
 use crate::topology::{EdgeId, Topology};
+use blocks::Block;
 use layout::GroupLayout;
 use plan::LatticePlan;
 use rayon::prelude::*;
@@ -270,18 +272,6 @@ fn corner_vertex(
     )
 }
 
-/// One block of consecutive source triangles and the slices of the final buffers it owns.
-struct Block<'a> {
-    /// Triangle offsets within the group.
-    tris: Range<usize>,
-    /// First output vertex of the block.
-    vertex_base: usize,
-    positions: &'a mut [[f32; 3]],
-    normals: &'a mut [[f32; 3]],
-    sources: &'a mut [VertexSource],
-    indices: &'a mut [u32],
-}
-
 /// What every block reads.
 struct Shared<'a> {
     mesh: &'a TriMesh,
@@ -321,32 +311,15 @@ fn tessellate_group(
 
     // Cut the buffers into per-block slices.
     let tris_per_block = (BLOCK_TRIANGLES / (n * n) as usize).max(1);
-    let mut blocks = Vec::with_capacity(range.len().div_ceil(tris_per_block));
-    let (mut positions, mut normals, mut sources, mut indices) = (
-        &mut out.positions[..],
-        &mut out.normals[..],
-        &mut out.sources[..],
-        &mut out.indices[..],
+    let ranges = (0..range.len())
+        .step_by(tris_per_block)
+        .map(|start| start..(start + tris_per_block).min(range.len()));
+    let blocks = blocks::split(
+        &mut out,
+        ranges,
+        |t| layout.base[t] as usize,
+        |t| t * per_tri_indices,
     );
-    for start in (0..range.len()).step_by(tris_per_block) {
-        let end = (start + tris_per_block).min(range.len());
-        let vertex_base = layout.base[start] as usize;
-        let vertices = layout.base[end] as usize - vertex_base;
-        let (p, rest_p) = std::mem::take(&mut positions).split_at_mut(vertices);
-        let (nr, rest_n) = std::mem::take(&mut normals).split_at_mut(vertices);
-        let (s, rest_s) = std::mem::take(&mut sources).split_at_mut(vertices);
-        let (i, rest_i) =
-            std::mem::take(&mut indices).split_at_mut((end - start) * per_tri_indices);
-        (positions, normals, sources, indices) = (rest_p, rest_n, rest_s, rest_i);
-        blocks.push(Block {
-            tris: start..end,
-            vertex_base,
-            positions: p,
-            normals: nr,
-            sources: s,
-            indices: i,
-        });
-    }
     let shared = Shared {
         mesh,
         topo,
@@ -360,17 +333,6 @@ fn tessellate_group(
         .into_par_iter()
         .for_each(|block| tessellate_block(&shared, block));
     out
-}
-
-impl Block<'_> {
-    /// Writes output vertex `slot` (numbered in the whole group).
-    #[inline]
-    fn put(&mut self, slot: usize, position: [f32; 3], normal: [f32; 3], source: VertexSource) {
-        let at = slot - self.vertex_base;
-        self.positions[at] = position;
-        self.normals[at] = normal;
-        self.sources[at] = source;
-    }
 }
 
 /// Evaluates and writes the vertices a block owns and all its triangles. Each output vertex is
