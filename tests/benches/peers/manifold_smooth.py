@@ -11,11 +11,12 @@ import json
 import struct
 import sys
 
-import manifold3d
 import numpy as np
 
 
 def main():
+    import manifold3d  # only the peer run needs it; write_glb is shared with shape.py
+
     raw_path, n, out_path = sys.argv[1], int(sys.argv[2]), sys.argv[3]
     raw = open(raw_path, "rb").read()
     if raw[:4] != b"G2TM":
@@ -31,7 +32,14 @@ def main():
     vp = np.ascontiguousarray(out.vert_properties, np.float32)
     p, nrm = np.ascontiguousarray(vp[:, :3]), np.ascontiguousarray(vp[:, 3:6])
     idx = np.ascontiguousarray(out.tri_verts, np.uint32)
-    blobs = [p.tobytes(), nrm.tobytes(), idx.tobytes()]
+    write_glb(out_path, p, nrm, idx)
+
+
+def write_glb(path, pos, nrm, tris):
+    """A GLB of one triangle primitive (float32 POSITION with min/max and NORMAL, uint32
+    indices)."""
+    p, n = np.asarray(pos, np.float32), np.asarray(nrm, np.float32)
+    blobs = [p.tobytes(), n.tobytes(), np.asarray(tris, np.uint32).tobytes()]
     offsets = np.cumsum([0] + [len(b) for b in blobs]).tolist()
     doc = {
         "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
@@ -41,20 +49,19 @@ def main():
             {"bufferView": 0, "componentType": 5126, "count": len(p), "type": "VEC3",
              "min": p.min(axis=0).tolist(), "max": p.max(axis=0).tolist()},
             {"bufferView": 1, "componentType": 5126, "count": len(p), "type": "VEC3"},
-            {"bufferView": 2, "componentType": 5125, "count": idx.size, "type": "SCALAR"}],
+            {"bufferView": 2, "componentType": 5125, "count": int(np.size(tris)), "type": "SCALAR"}],
         "bufferViews": [{"buffer": 0, "byteOffset": offsets[k], "byteLength": len(b)}
                         for k, b in enumerate(blobs)],
         "buffers": [{"byteLength": offsets[-1]}],
     }
     text = json.dumps(doc, separators=(",", ":")).encode()
     text += b" " * (-len(text) % 4)
-    with open(out_path, "wb") as f:
+    with open(path, "wb") as f:
         f.write(struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(text) + 8 + offsets[-1]))
         f.write(struct.pack("<I4s", len(text), b"JSON") + text)
         f.write(struct.pack("<I4s", offsets[-1], b"BIN\0"))
         for b in blobs:
             f.write(b)
-
 
 if __name__ == "__main__":
     main()

@@ -23,6 +23,10 @@ import tempfile
 
 import numpy as np
 
+# One GLB writer for the benches: the Manifold peer's.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "peers"))
+from manifold_smooth import write_glb  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 R_MAJOR, R_MINOR = 1.0, 0.35
@@ -95,35 +99,6 @@ def read_glb(path):
             tris.append(t + base)
             base += len(p)
     return np.vstack(pos), np.vstack(nrm), np.vstack(tris)
-
-
-def write_glb(path, pos, nrm, tris):
-    """A GLB of one triangle primitive (float32 POSITION with min/max and NORMAL, uint32
-    indices)."""
-    p, n = pos.astype(np.float32), nrm.astype(np.float32)
-    blobs = [p.tobytes(), n.tobytes(), tris.astype(np.uint32).tobytes()]
-    offsets = np.cumsum([0] + [len(b) for b in blobs]).tolist()
-    doc = {
-        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": len(p), "type": "VEC3",
-             "min": p.min(axis=0).tolist(), "max": p.max(axis=0).tolist()},
-            {"bufferView": 1, "componentType": 5126, "count": len(p), "type": "VEC3"},
-            {"bufferView": 2, "componentType": 5125, "count": tris.size, "type": "SCALAR"}],
-        "bufferViews": [{"buffer": 0, "byteOffset": offsets[k], "byteLength": len(b)}
-                        for k, b in enumerate(blobs)],
-        "buffers": [{"byteLength": offsets[-1]}],
-    }
-    text = json.dumps(doc, separators=(",", ":")).encode()
-    text += b" " * (-len(text) % 4)
-    with open(path, "wb") as f:
-        f.write(struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(text) + 8 + offsets[-1]))
-        f.write(struct.pack("<I4s", len(text), b"JSON") + text)
-        f.write(struct.pack("<I4s", offsets[-1], b"BIN\0"))
-        for b in blobs:
-            f.write(b)
 
 
 def exact(kind, p):
