@@ -303,3 +303,24 @@ pub fn smooth_meshes() -> Vec<(&'static str, TriMesh)> {
         ("torus", torus(10)),
     ]
 }
+
+/// Number of edges that only one triangle uses, after welding vertices by exact position.
+pub fn boundary_edges(positions: &[[f32; 3]], indices: &[u32]) -> usize {
+    let mut welded: std::collections::HashMap<[u32; 3], u32> = HashMap::new();
+    let ids: Vec<u32> = positions
+        .iter()
+        .map(|p| {
+            let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+            let next = welded.len() as u32;
+            *welded.entry(key).or_insert(next)
+        })
+        .collect();
+    let mut uses: std::collections::HashMap<(u32, u32), usize> = HashMap::new();
+    for t in indices.chunks(3) {
+        for k in 0..3 {
+            let (a, b) = (ids[t[k] as usize], ids[t[(k + 1) % 3] as usize]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    uses.values().filter(|&&u| u == 1).count()
+}

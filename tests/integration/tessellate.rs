@@ -4,8 +4,6 @@
 // One group is one output primitive; a single range is the common case, not a mistake.
 #![allow(clippy::single_range_in_vec_init)]
 
-use std::collections::HashMap;
-
 use crate::support::*;
 use g2tess::mesh::TriMesh;
 use g2tess::surface::{G2Surface, Profile, Surface};
@@ -28,27 +26,6 @@ fn run(mesh: &TriMesh, h: f64, level: u32) -> (Topology, Vec<f64>, DenseMesh) {
     .pop()
     .unwrap();
     (topo, hs, dense)
-}
-
-/// Number of edges that only one triangle uses, after welding vertices by exact position.
-fn boundary_edges(positions: &[[f32; 3]], indices: &[u32]) -> usize {
-    let mut welded: HashMap<[u32; 3], u32> = HashMap::new();
-    let ids: Vec<u32> = positions
-        .iter()
-        .map(|p| {
-            let key = p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
-            let next = welded.len() as u32;
-            *welded.entry(key).or_insert(next)
-        })
-        .collect();
-    let mut uses: HashMap<(u32, u32), usize> = HashMap::new();
-    for t in indices.chunks(3) {
-        for k in 0..3 {
-            let (a, b) = (ids[t[k] as usize], ids[t[(k + 1) % 3] as usize]);
-            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    uses.values().filter(|&&u| u == 1).count()
 }
 
 fn input_boundary_edges(mesh: &TriMesh) -> usize {
