@@ -62,7 +62,13 @@ pub fn write(
             status: o.status,
             error: o.error.as_deref(),
             seconds: o.seconds,
-            warnings: Warnings(o.report.iter().flat_map(|r| r.warnings()).cloned().collect()),
+            warnings: Warnings(
+                o.report
+                    .iter()
+                    .flat_map(|r| r.warnings())
+                    .cloned()
+                    .collect(),
+            ),
             result: o.report.as_ref(),
         })
         .collect();

@@ -8,9 +8,10 @@
 //! counts, `message`), so a build can gate on a kind without parsing sentences.
 //!
 //! Numbering: triangles and vertices of the geometry checks count over the mesh's triangle
-//! primitives joined in file order (the first primitive's first); edges and welded vertices are
-//! those of the welded mesh, as `--explain-h` lists them; vertices of the normal warnings are
-//! the primitive's own.
+//! primitives joined in file order (the first primitive's first), after a primitive without
+//! normals had its vertices split where its generated normals are; edges and welded vertices
+//! are those of the welded mesh, as `--explain-h` lists them; vertices of the normal warnings
+//! are the primitive's own, as read.
 
 use std::fmt;
 
