@@ -596,6 +596,58 @@ mod tests {
         );
     }
 
+    /// The sentences of the surfaces' and the sharpness stage's warnings are the ones their own
+    /// `Display` gave, prefixed with the mesh as the report always did.
+    #[test]
+    fn surface_and_sharpness_sentences_are_unchanged() {
+        use crate::topology::EdgeId;
+        let said = [
+            scheme::Warning::NoProjectionPlane {
+                edges: 3,
+                first: EdgeId(9),
+            },
+            scheme::Warning::Edges(topology::Warning::BlendIgnored {
+                kind: EdgeKind::NonManifold,
+                edges: 2,
+                first: EdgeId(4),
+            }),
+            scheme::Warning::Edges(topology::Warning::BlendIgnored {
+                kind: EdgeKind::Boundary,
+                edges: 1,
+                first: EdgeId(0),
+            }),
+        ];
+        for w in &said {
+            assert_eq!(
+                Warning::from_surface(5, None, w).to_string(),
+                format!("mesh 5: {w}")
+            );
+        }
+        let entry = SharpnessWarning::EntryOnUnblendedEdge {
+            at: Location::Toml {
+                file: "robot.g2tess.toml".into(),
+                line: 2,
+                path: "edges[0]".into(),
+            },
+            edge: EdgeId(3),
+            kind: EdgeKind::Boundary,
+            h: 0.1,
+        };
+        let typed = Warning::from_sharpness(1, &entry);
+        assert_eq!(typed.to_string(), entry.to_string());
+        assert_eq!(
+            serde_json::to_value(&typed).unwrap(),
+            serde_json::json!({
+                "kind": "unblended_edge_entry",
+                "mesh": 1,
+                "edge": 3,
+                "edge_kind": "boundary",
+                "h": 0.1,
+                "at": {"file": "robot.g2tess.toml", "line": 2, "path": "edges[0]"},
+            })
+        );
+    }
+
     #[test]
     fn the_json_form_has_kind_facts_and_message() {
         let w = Warnings(vec![plane(vec![4], 3)]);
