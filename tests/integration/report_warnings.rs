@@ -392,3 +392,31 @@ fn a_target_warning_the_base_already_gives_is_not_repeated() {
     let w = one(&all, "no_projection_plane");
     assert_eq!(w["targets"], json!([]));
 }
+
+/// `--merge-reports` keeps each record whole: the typed warnings come through a merge as
+/// written.
+#[test]
+fn merged_reports_keep_the_typed_warnings() {
+    let dir = corpus::temp_dir();
+    let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1e-5, 0.0]];
+    let input = write(dir.path(), &p, None, &[0, 1, 2]);
+    let written = details(&input, &[]);
+    let merged = dir.path().join("merged.json");
+    let out = corpus::g2tess()
+        .arg("--merge-reports")
+        .arg(&merged)
+        .arg(dir.path().join("report.json"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let merged: Value = serde_json::from_slice(&std::fs::read(&merged).unwrap()).unwrap();
+    assert_eq!(
+        merged["files"][0]["warning_details"].as_array().unwrap(),
+        &written
+    );
+    assert_eq!(merged["format"], 1);
+}
