@@ -20,7 +20,7 @@ use serde::{Serialize, Serializer};
 
 use crate::sharpness::{Location, SharpnessWarning};
 use crate::surface::scheme;
-use crate::topology::{self, EdgeKind};
+use crate::topology::{self, EdgeId, EdgeKind};
 
 /// One warning of one mesh, with the facts that locate it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -274,7 +274,8 @@ pub fn merge_target_warnings(warnings: &mut Vec<Warning>, from_targets: Vec<Warn
 }
 
 /// The sentence users have always read: `mesh 0: 3 zero-area triangles (first: 4, 7, 9) …`,
-/// or an accessor path for the normal warnings, or the sidecar line for an h entry.
+/// or an accessor path for the normal warnings, or the sidecar line for an h entry. The
+/// sharpness stage's and the surfaces' warnings keep the words of their own `Display`.
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -414,19 +415,18 @@ impl fmt::Display for Warning {
                 "meshes[{mesh}].primitives[{primitive}]: no NORMAL; normals generated (angle-weighted, split at {crease_angle}°)"
             ),
             Warning::UnblendedEdgeEntry {
-                edge_kind, h, at, ..
-            } => {
-                let kind = match edge_kind {
-                    EdgeKind::Interior => "an interior",
-                    EdgeKind::Boundary => "a boundary",
-                    EdgeKind::NonManifold => "a non-manifold",
-                    EdgeKind::Degenerate => "a degenerate",
-                };
-                write!(
-                    f,
-                    "{at}: h = {h} has no effect on {kind} edge, which always uses h = 0"
-                )
+                edge,
+                edge_kind,
+                h,
+                at,
+                ..
+            } => SharpnessWarning::EntryOnUnblendedEdge {
+                at: at.clone(),
+                edge: EdgeId(*edge as u32),
+                kind: *edge_kind,
+                h: *h,
             }
+            .fmt(f),
             Warning::BlendIgnored {
                 mesh,
                 targets,
@@ -435,11 +435,12 @@ impl fmt::Display for Warning {
                 edge,
             } => {
                 surface_prefix(f, *mesh, targets)?;
-                write!(
-                    f,
-                    "h > 0 asked for on {count} {} edge(s) (first: edge {edge}); they use h = 0",
-                    kind_name(*edge_kind).replace('_', "-")
-                )
+                topology::Warning::BlendIgnored {
+                    kind: *edge_kind,
+                    edges: *count,
+                    first: EdgeId(*edge as u32),
+                }
+                .fmt(f)
             }
             Warning::NoProjectionPlane {
                 mesh,
@@ -448,10 +449,11 @@ impl fmt::Display for Warning {
                 edge,
             } => {
                 surface_prefix(f, *mesh, targets)?;
-                write!(
-                    f,
-                    "no projection plane for {count} folded edge(s) (first: edge {edge}); they are creases"
-                )
+                scheme::Warning::NoProjectionPlane {
+                    edges: *count,
+                    first: EdgeId(*edge as u32),
+                }
+                .fmt(f)
             }
         }
     }
@@ -491,7 +493,7 @@ fn accessor_label(accessor: Option<usize>) -> String {
     accessor.map_or(String::new(), |a| format!(" (accessors[{a}])"))
 }
 
-/// The JSON name of an edge kind, as in the report's `edge_kind` field.
+/// The JSON name of an edge kind (the report's `edge_kind` field).
 fn kind_name(kind: EdgeKind) -> &'static str {
     match kind {
         EdgeKind::Interior => "interior",
@@ -600,7 +602,6 @@ mod tests {
     /// `Display` gave, prefixed with the mesh as the report always did.
     #[test]
     fn surface_and_sharpness_sentences_are_unchanged() {
-        use crate::topology::EdgeId;
         let said = [
             scheme::Warning::NoProjectionPlane {
                 edges: 3,

@@ -266,17 +266,15 @@ fn an_entry_on_a_boundary_edge_names_the_sidecar_line_and_the_edge() {
     );
 }
 
-/// Two triangles on the edge 0-1 (a flat hinge, normals +Z), with morph targets given as
-/// position and normal deltas per vertex.
-fn hinge_with_targets(dir: &Path, targets: &[[[f32; 3]; 8]]) -> PathBuf {
-    let p = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [0.5, 1.0, 0.0],
-        [0.5, -1.0, 0.0],
-    ];
-    let n = [[0.0, 0.0, 1.0]; 4];
-    let (mut json, mut bin) = hostile::mesh_gltf(&p, Some(&n), &[0, 1, 2, 1, 0, 3], "t.bin");
+/// Two triangles on the edge 0-1 over the four points `p` with normals `n`, with morph targets
+/// given as four position deltas then four normal deltas.
+fn hinge_with_targets(
+    dir: &Path,
+    p: &[[f32; 3]; 4],
+    n: &[[f32; 3]; 4],
+    targets: &[[[f32; 3]; 8]],
+) -> PathBuf {
+    let (mut json, mut bin) = hostile::mesh_gltf(p, Some(n), &[0, 1, 2, 1, 0, 3], "t.bin");
     let mut list = Vec::new();
     for t in targets {
         let mut target = serde_json::Map::new();
@@ -339,7 +337,14 @@ fn a_morph_target_that_folds_an_edge_is_reported_once_naming_its_targets() {
         [0.0, 1.0, -1.0],
         [0.0, 1.0, -1.0],
     ];
-    let input = hinge_with_targets(dir.path(), &[knife, [[0.0; 3]; 8], knife]);
+    let flat = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 1.0, 0.0],
+        [0.5, -1.0, 0.0],
+    ];
+    let up = [[0.0, 0.0, 1.0]; 4];
+    let input = hinge_with_targets(dir.path(), &flat, &up, &[knife, [[0.0; 3]; 8], knife]);
     let args = ["--scheme", "hybrid", "--crease-angle", "180"];
     let all = details(&input, &args);
     let w = one(&all, "no_projection_plane");
@@ -357,37 +362,20 @@ fn a_morph_target_that_folds_an_edge_is_reported_once_naming_its_targets() {
 #[test]
 fn a_target_warning_the_base_already_gives_is_not_repeated() {
     let dir = corpus::temp_dir();
-    let (mut json, bin) = {
-        let p = [
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.5, 1.0, 0.0],
-            [0.5, 1.0, 0.05],
-        ];
-        let n = [
-            [0.0, -1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-        ];
-        hostile::mesh_gltf(&p, Some(&n), &[0, 1, 2, 1, 0, 3], "t.bin")
-    };
+    let knife = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 1.0, 0.0],
+        [0.5, 1.0, 0.05],
+    ];
+    let n = [
+        [0.0, -1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
     // One target that moves nothing: its surface is the base's, with the same warning.
-    let offset = bin.len();
-    let mut bin = bin;
-    bin.extend([0u8; 48]);
-    json["bufferViews"]
-        .as_array_mut()
-        .unwrap()
-        .push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 48}));
-    let view = json["bufferViews"].as_array().unwrap().len() - 1;
-    json["accessors"].as_array_mut().unwrap().push(json!({"bufferView": view, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0.0, 0.0, 0.0], "max": [0.0, 0.0, 0.0]}));
-    let acc = json["accessors"].as_array().unwrap().len() - 1;
-    json["meshes"][0]["primitives"][0]["targets"] = json!([{"POSITION": acc}]);
-    json["buffers"][0]["byteLength"] = json!(bin.len());
-    std::fs::write(dir.path().join("t.bin"), bin).unwrap();
-    let input = dir.path().join("t.gltf");
-    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let input = hinge_with_targets(dir.path(), &knife, &n, &[[[0.0; 3]; 8]]);
     let all = details(&input, &["--scheme", "hybrid", "--crease-angle", "180"]);
     let w = one(&all, "no_projection_plane");
     assert_eq!(w["targets"], json!([]));
