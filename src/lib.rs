@@ -27,7 +27,8 @@
 //! - [`tangents`]: MikkTSpace tangents for the dense output.
 //! - [`optimize`]: meshoptimizer's vertex cache and fetch ordering.
 //! - [`options`]: the resolved settings that flow down through every stage.
-//! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages.
+//! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages;
+//!   each fallback a stage takes reaches its report as a typed [`pipeline::Warning`].
 //! - [`render`]: pictures of any document on the CPU (shaded, zebra, flat, and the input's
 //!   edges coloured by h), side by side with one camera, as PNG.
 //! - [`huge_pages`]: the binary's allocator, which asks Linux for transparent huge pages on

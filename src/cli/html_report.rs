@@ -237,11 +237,10 @@ fn asset(
             );
         }
         h.push_str("</tbody></table>\n");
-        let warnings: Vec<&str> = r.warnings().collect();
-        if !warnings.is_empty() {
+        if r.warnings().next().is_some() {
             h.push_str("<ul class=\"warnings\">");
-            for w in warnings {
-                let _ = write!(h, "<li>{}</li>", escape(w));
+            for w in r.warnings() {
+                let _ = write!(h, "<li>{}</li>", escape(&w.to_string()));
             }
             h.push_str("</ul>\n");
         }

@@ -1,11 +1,13 @@
 //! `--report FILE.json`: one record per input, for a CI system to gate on.
 //!
 //! Field names are an interface (documented in the README, section "The JSON report"): add
-//! fields freely, rename or remove none without bumping `format`.
+//! fields freely, rename or remove none without bumping `format`. Warnings keep their sentences
+//! under `warnings` and add their typed form under `warning_details`: a reader of either
+//! format-1 report keeps working.
 
 use std::path::Path;
 
-use g2tess::pipeline::FileReport;
+use g2tess::pipeline::{FileReport, Warnings};
 use serde::Serialize;
 
 use super::batch::{Outcome, Status, Summary};
@@ -33,8 +35,10 @@ struct Record<'a> {
     status: Status,
     error: Option<&'a str>,
     seconds: f64,
-    /// Every warning of every mesh, also found per mesh under `meshes`.
-    warnings: Vec<&'a str>,
+    /// Every warning of every mesh, also found per mesh under `meshes`: the sentences as
+    /// `warnings`, and as `warning_details` objects with their kind and location.
+    #[serde(flatten)]
+    warnings: Warnings,
     /// Counts, sizes, stage times and per-mesh continuity of a processed or checked file.
     #[serde(flatten)]
     result: Option<&'a FileReport>,
@@ -58,7 +62,13 @@ pub fn write(
             status: o.status,
             error: o.error.as_deref(),
             seconds: o.seconds,
-            warnings: o.report.iter().flat_map(|r| r.warnings()).collect(),
+            warnings: Warnings(
+                o.report
+                    .iter()
+                    .flat_map(|r| r.warnings())
+                    .cloned()
+                    .collect(),
+            ),
             result: o.report.as_ref(),
         })
         .collect();

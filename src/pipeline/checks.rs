@@ -11,6 +11,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::warning::Warning;
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeKind, Topology};
 
@@ -25,43 +26,40 @@ const EXAMPLES: usize = 3;
 
 /// One warning per odd kind of geometry found in `mesh` (the joined triangle primitives of mesh
 /// `index`), each naming the fallback applied.
-pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<String> {
+pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warning> {
     let mut out = Vec::new();
     let degenerate: Vec<usize> = (0..topo.degenerate.len())
         .filter(|&t| topo.degenerate[t])
         .collect();
-    say(
-        &mut out,
-        index,
-        degenerate.len(),
-        first(&degenerate),
-        "zero-area triangles",
-        "are kept flat; their edges are not blended",
-    );
+    if !degenerate.is_empty() {
+        out.push(Warning::DegenerateTriangles {
+            mesh: index,
+            count: degenerate.len(),
+            triangles: first(&degenerate),
+        });
+    }
 
     let sliver_cos = SLIVER_ANGLE.cos();
     let slivers: Vec<usize> = (0..mesh.triangles.len())
         .into_par_iter()
         .filter(|&t| !topo.degenerate[t] && largest_angle_cosine(mesh, t) > sliver_cos)
         .collect();
-    say(
-        &mut out,
-        index,
-        slivers.len(),
-        first(&slivers),
-        "sliver triangles",
-        "(an angle below 0.06°) are smoothed like the others; their shading may be poor",
-    );
+    if !slivers.is_empty() {
+        out.push(Warning::SliverTriangles {
+            mesh: index,
+            count: slivers.len(),
+            triangles: first(&slivers),
+        });
+    }
 
     let duplicates = duplicate_triangles(topo);
-    say(
-        &mut out,
-        index,
-        duplicates.len(),
-        first(&duplicates),
-        "duplicate triangles",
-        "(same corners as an earlier one) are kept; their shared edges are not blended",
-    );
+    if !duplicates.is_empty() {
+        out.push(Warning::DuplicateTriangles {
+            mesh: index,
+            count: duplicates.len(),
+            triangles: first(&duplicates),
+        });
+    }
 
     let mut used = vec![false; mesh.positions.len()];
     for t in &mesh.triangles {
@@ -70,14 +68,13 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Strin
         }
     }
     let unused: Vec<usize> = (0..used.len()).filter(|&v| !used[v]).collect();
-    say(
-        &mut out,
-        index,
-        unused.len(),
-        first(&unused),
-        "vertices used by no triangle",
-        "are not written",
-    );
+    if !unused.is_empty() {
+        out.push(Warning::UnusedVertices {
+            mesh: index,
+            count: unused.len(),
+            vertices: first(&unused),
+        });
+    }
 
     let facing_away: Vec<usize> = (0..mesh.triangles.len())
         .into_par_iter()
@@ -91,85 +88,66 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Strin
                     .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
         })
         .collect();
-    say(
-        &mut out,
-        index,
-        facing_away.len(),
-        first(&facing_away),
-        "triangles whose normals all face away from their winding",
-        "follow their normals (the surface is oriented by the normals, not the winding)",
-    );
+    if !facing_away.is_empty() {
+        out.push(Warning::NormalsFacingAway {
+            mesh: index,
+            count: facing_away.len(),
+            triangles: first(&facing_away),
+        });
+    }
 
     let count = |kind: EdgeKind| topo.edges.iter().filter(|e| e.kind == kind).count();
     let boundary = count(EdgeKind::Boundary);
     if boundary > 0 {
-        out.push(format!(
-            "mesh {index}: {boundary} open boundary edges are not blended (the surface follows the input there)"
-        ));
+        out.push(Warning::BoundaryEdges {
+            mesh: index,
+            count: boundary,
+        });
     }
     let non_manifold: Vec<usize> = (0..topo.edges.len())
         .filter(|&e| topo.edges[e].kind == EdgeKind::NonManifold)
         .collect();
-    say(
-        &mut out,
-        index,
-        non_manifold.len(),
-        first(&non_manifold),
-        "non-manifold edges (three or more triangles)",
-        "are not blended",
-    );
+    if !non_manifold.is_empty() {
+        out.push(Warning::NonManifoldEdges {
+            mesh: index,
+            count: non_manifold.len(),
+            edges: first(&non_manifold),
+        });
+    }
 
     let flipped: Vec<usize> = (0..topo.edges.len())
         .filter(|&e| topo.edges[e].kind == EdgeKind::Interior && same_direction(topo, e))
         .collect();
-    say(
-        &mut out,
-        index,
-        flipped.len(),
-        first(&flipped),
-        "edges between triangles of opposite winding",
-        "are smoothed as usual (the surface is oriented by the normals, not the winding)",
-    );
+    if !flipped.is_empty() {
+        out.push(Warning::OppositeWindingEdges {
+            mesh: index,
+            count: flipped.len(),
+            edges: first(&flipped),
+        });
+    }
 
     let bow_ties = bow_tie_vertices(topo);
-    say(
-        &mut out,
-        index,
-        bow_ties.len(),
-        first(&bow_ties),
-        "bow-tie vertices (triangle fans that touch only at the vertex)",
-        "are kept; each fan is smoothed on its own",
-    );
+    if !bow_ties.is_empty() {
+        out.push(Warning::BowTieVertices {
+            mesh: index,
+            count: bow_ties.len(),
+            vertices: first(&bow_ties),
+        });
+    }
 
     let pieces = pieces(topo);
     if pieces > MANY_PIECES {
-        out.push(format!(
-            "mesh {index}: {pieces} disconnected pieces; each is smoothed on its own (expected a welded mesh?)"
-        ));
+        out.push(Warning::ManyPieces {
+            mesh: index,
+            pieces,
+        });
     }
     out
 }
 
-/// Adds "mesh i: N things (first: a, b, c) fallback" when there are any.
-fn say(
-    out: &mut Vec<String>,
-    index: usize,
-    count: usize,
-    examples: &[usize],
-    noun: &str,
-    what: &str,
-) {
-    if count > 0 {
-        let list: Vec<String> = examples.iter().map(ToString::to_string).collect();
-        out.push(format!(
-            "mesh {index}: {count} {noun} (first: {}) {what}",
-            list.join(", ")
-        ));
-    }
-}
-
-fn first(v: &[usize]) -> &[usize] {
-    &v[..v.len().min(EXAMPLES)]
+/// The first few of `v`, as examples.
+fn first(v: &[usize]) -> Vec<usize> {
+    v[..v.len().min(EXAMPLES)].to_vec()
 }
 
 /// The cosine of the smallest angle of triangle `t`: comparing cosines instead of angles spares

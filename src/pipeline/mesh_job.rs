@@ -17,6 +17,7 @@ use super::error::Error;
 use super::morph;
 use super::primitive_out::{self, Prepared};
 use super::report::{EdgeFigures, MeshReport, PrimitiveReport};
+use super::warning::{merge_target_warnings, Warning};
 use crate::gltf_io::{self, PrimitiveData};
 use crate::mesh::TriMesh;
 use crate::options::Options;
@@ -83,7 +84,7 @@ pub(super) fn resolve(
     sharpness: &AssetSharpness,
     options: &Options,
     asset: &Path,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> Result<Resolved, Error> {
     let mut prepared: Vec<Prepared> = input
         .primitives
@@ -118,7 +119,12 @@ pub(super) fn resolve(
     );
     warnings.extend(checks);
     let params = params?;
-    warnings.extend(params.warnings.iter().map(|w| w.to_string()));
+    warnings.extend(
+        params
+            .warnings
+            .iter()
+            .map(|w| Warning::from_sharpness(input.mesh, w)),
+    );
     Ok(Resolved {
         prepared,
         mesh,
@@ -149,15 +155,15 @@ pub fn smooth_mesh(
         groups,
         topo,
         params,
-    } = resolve(input, sharpness, options, asset, &mut report.warnings)?;
+    } = resolve(input, sharpness, options, asset, &mut report.warnings.0)?;
     report.times.sharpness = lap(&clock, 0.0);
     stop_if_cancelled(options, asset)?;
 
     let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &params.effective);
-    report.warnings.extend(
+    report.warnings.0.extend(
         surface_warnings
-            .into_iter()
-            .map(|w| format!("mesh {}: {w}", input.mesh)),
+            .iter()
+            .map(|w| Warning::from_surface(input.mesh, None, w)),
     );
     report.edges = if options.report_figures {
         EdgeFigures::measure(surface.as_ref(), &topo, &params.effective)
@@ -205,7 +211,7 @@ pub fn smooth_mesh(
 
     let attr_start = Instant::now();
     let mut primitives = Vec::with_capacity(prepared.len());
-    let targets = morph::targets(
+    let (targets, target_warnings) = morph::targets(
         &mesh,
         &topo,
         &params.effective,
@@ -215,6 +221,11 @@ pub fn smooth_mesh(
         options,
         &remaps,
     );
+    let target_warnings = target_warnings
+        .iter()
+        .map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
+        .collect();
+    merge_target_warnings(&mut report.warnings.0, target_warnings);
     for (k, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
         report.primitives.push(PrimitiveReport {
             primitive: input.primitives[k].index,
@@ -290,10 +301,9 @@ pub(super) fn build_surface(
     mesh: &TriMesh,
     topo: &Topology,
     h: &[f64],
-) -> (Box<dyn Surface>, Vec<String>) {
+) -> (Box<dyn Surface>, Vec<scheme::Warning>) {
     let params = options.scheme_params();
-    let (surface, warnings) = scheme::build_surface(options.scheme, mesh, topo, h, &params);
-    (surface, warnings.iter().map(ToString::to_string).collect())
+    scheme::build_surface(options.scheme, mesh, topo, h, &params)
 }
 
 /// Checks a primitive's positions and normals, generating normals where there are none.
@@ -301,7 +311,7 @@ fn prepare(
     mesh: usize,
     input: &PrimitiveInput,
     crease_angle: f64,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> Result<Prepared, gltf_io::Error> {
     let at = format!("meshes[{mesh}].primitives[{}]", input.index);
     let data = &input.data;
@@ -334,23 +344,27 @@ fn prepare(
                 .filter(|&v| normals[v] != DVec3::ZERO && !unit_to_validator(raw[v]))
                 .collect();
             if let Some(&first) = rescaled.first() {
-                warnings.push(format!(
-                    "{at}.attributes.NORMAL{}: {} normals not of unit length (first: vertex {first}, length {}) normalized",
-                    accessor_label(input.normal_accessor),
-                    rescaled.len(),
-                    raw[first].length() as f32
-                ));
+                warnings.push(Warning::NormalsRescaled {
+                    mesh,
+                    primitive: input.index,
+                    accessor: input.normal_accessor,
+                    count: rescaled.len(),
+                    vertex: first,
+                    length: raw[first].length() as f32,
+                });
             }
             let broken: Vec<usize> = (0..normals.len())
                 .filter(|&v| normals[v] == DVec3::ZERO || !normals[v].is_finite())
                 .collect();
             if let Some(&first) = broken.first() {
                 repair_normals(&points, &triangles, &broken, &mut normals);
-                let accessor = accessor_label(input.normal_accessor);
-                warnings.push(format!(
-                    "{at}.attributes.NORMAL{accessor}: {} zero-length normals (first: vertex {first}) replaced by the angle-weighted normal of their faces",
-                    broken.len()
-                ));
+                warnings.push(Warning::NormalsRepaired {
+                    mesh,
+                    primitive: input.index,
+                    accessor: input.normal_accessor,
+                    count: broken.len(),
+                    vertex: first,
+                });
             }
             Ok(Prepared::new(
                 data.clone(),
@@ -362,9 +376,11 @@ fn prepare(
         }
         None => {
             let generated = normals::generate(&points, &triangles, crease_angle);
-            warnings.push(format!(
-                "{at}: no NORMAL; normals generated (angle-weighted, split at {crease_angle}°)"
-            ));
+            warnings.push(Warning::NormalsGenerated {
+                mesh,
+                primitive: input.index,
+                crease_angle,
+            });
             Ok(Prepared::with_generated_normals(
                 data,
                 &points,
@@ -373,11 +389,6 @@ fn prepare(
             ))
         }
     }
-}
-
-/// `" (accessors[3])"`, or nothing when the accessor is not known.
-fn accessor_label(accessor: Option<usize>) -> String {
-    accessor.map_or(String::new(), |a| format!(" (accessors[{a}])"))
 }
 
 /// Whether `n` is unit length within the Khronos validator's tolerance for unit vectors.

@@ -15,6 +15,7 @@ mod mesh_job;
 mod morph;
 mod primitive_out;
 mod report;
+mod warning;
 
 use std::path::Path;
 use std::time::Instant;
@@ -29,6 +30,7 @@ pub use density::AdaptiveFigures;
 pub use error::Error;
 pub use mesh_job::{MeshInput, MeshOutput};
 pub use report::{EdgeFigures, FileReport, MeshReport, PrimitiveReport, StageTimes};
+pub use warning::{Warning, Warnings};
 
 /// Reads `input`, processes it and writes `output` atomically.
 pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<FileReport, Error> {
@@ -262,7 +264,7 @@ pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<Str
     Ok(rows
         .iter()
         .map(ToString::to_string)
-        .chain(warnings)
+        .chain(warnings.iter().map(ToString::to_string))
         .collect())
 }
 

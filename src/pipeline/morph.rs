@@ -16,6 +16,7 @@ use crate::gltf_io::MorphDeltas;
 use crate::mesh::TriMesh;
 use crate::optimize::remap_stream;
 use crate::options::Options;
+use crate::surface::scheme;
 use crate::topology::Topology;
 
 /// The surface of one morph target at the output vertices of one primitive.
@@ -27,7 +28,9 @@ pub struct TargetSurface {
     pub normals: Vec<[f32; 3]>,
 }
 
-/// Per primitive, per target: the morphed surface at that primitive's output vertices.
+/// Per primitive, per target: the morphed surface at that primitive's output vertices; and
+/// the warnings the targets' surfaces gave, each with its target (the report merges them with
+/// the base surface's).
 ///
 /// `remaps` are the vertex orders [`crate::optimize::order_for_overdraw`] gave each primitive (`None`
 /// where it did not run).
@@ -41,16 +44,18 @@ pub fn targets(
     density: &Density,
     options: &Options,
     remaps: &[Option<Vec<u32>>],
-) -> Vec<Vec<TargetSurface>> {
+) -> (Vec<Vec<TargetSurface>>, Vec<(usize, scheme::Warning)>) {
     let count = prepared
         .iter()
         .map(|p| p.data.targets.len())
         .max()
         .unwrap_or(0);
     let mut out: Vec<Vec<TargetSurface>> = vec![Vec::with_capacity(count); prepared.len()];
+    let mut warnings = Vec::new();
     for t in 0..count {
         let moved = displaced(mesh, prepared, t);
-        let (surface, _) = super::mesh_job::build_surface(options, &moved, topo, h);
+        let (surface, said) = super::mesh_job::build_surface(options, &moved, topo, h);
+        warnings.extend(said.into_iter().map(|w| (t, w)));
         let dense = density.tessellate(&moved, topo, h, surface.as_ref(), groups);
         for (k, d) in dense.into_iter().enumerate() {
             let (positions, normals) = match &remaps[k] {
@@ -66,7 +71,7 @@ pub fn targets(
             out[k].push(TargetSurface { positions, normals });
         }
     }
-    out
+    (out, warnings)
 }
 
 /// The joined mesh displaced by target `t` (a primitive without that target stays put).

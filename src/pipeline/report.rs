@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::density::AdaptiveFigures;
+use super::warning::{Warning, Warnings};
 use crate::continuity::angle_deg;
 use crate::optimize::CacheFigures;
 use crate::surface::blend::map_point;
@@ -214,8 +215,10 @@ pub struct MeshReport {
     /// or budget.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub adaptive: Option<AdaptiveFigures>,
-    /// What was repaired or ignored, one sentence each.
-    pub warnings: Vec<String>,
+    /// What was repaired or ignored, typed; written as the `warnings` sentences and the
+    /// `warning_details` objects.
+    #[serde(flatten)]
+    pub warnings: Warnings,
     /// Its stage times.
     #[serde(skip)]
     pub times: StageTimes,
@@ -257,10 +260,9 @@ impl FileReport {
         self.meshes.push(mesh);
     }
 
-    /// Every warning of every mesh.
-    pub fn warnings(&self) -> impl Iterator<Item = &str> {
-        self.meshes
-            .iter()
-            .flat_map(|m| m.warnings.iter().map(String::as_str))
+    /// Every warning of every mesh, in mesh order; its [`std::fmt::Display`] is the sentence
+    /// users read.
+    pub fn warnings(&self) -> impl Iterator<Item = &Warning> + Clone {
+        self.meshes.iter().flat_map(|m| m.warnings.0.iter())
     }
 }

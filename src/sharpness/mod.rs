@@ -122,6 +122,8 @@ pub enum SharpnessWarning {
     /// An edge entry asks for h > 0 on an edge the surface never blends.
     EntryOnUnblendedEdge {
         at: Location,
+        /// The welded edge the entry names.
+        edge: crate::topology::EdgeId,
         kind: EdgeKind,
         h: f64,
     },
@@ -130,7 +132,7 @@ pub enum SharpnessWarning {
 impl std::fmt::Display for SharpnessWarning {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            SharpnessWarning::EntryOnUnblendedEdge { at, kind, h } => {
+            SharpnessWarning::EntryOnUnblendedEdge { at, kind, h, .. } => {
                 let kind = match kind {
                     EdgeKind::Interior => "an interior",
                     EdgeKind::Boundary => "a boundary",

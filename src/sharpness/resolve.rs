@@ -227,6 +227,7 @@ impl Explicit<'_, '_> {
         if kind != EdgeKind::Interior && entry.h > 0.0 {
             self.warnings.push(SharpnessWarning::EntryOnUnblendedEdge {
                 at: Location::clone(&entry.at),
+                edge: id,
                 kind,
                 h: entry.h,
             });

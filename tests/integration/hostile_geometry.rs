@@ -45,7 +45,7 @@ fn process(
     let report =
         g2tess::pipeline::process_document(&mut doc, Path::new(&input), &Options::default())
             .unwrap();
-    Ok(report.warnings().map(str::to_owned).collect())
+    Ok(report.warnings().map(ToString::to_string).collect())
 }
 
 fn warned(warnings: &[String], what: &str) {

@@ -29,6 +29,7 @@ mod pipeline_morph;
 mod pipeline_sharpness;
 mod render;
 mod render_report;
+mod report_warnings;
 mod schemes_continuity;
 mod schemes_creases;
 mod schemes_lattice;
