@@ -30,8 +30,6 @@
 //! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages.
 //! - [`render`]: pictures of any document on the CPU (shaded, zebra, flat, and the input's
 //!   edges coloured by h), side by side with one camera, as PNG.
-//! - [`huge_pages`]: the binary's allocator, which asks Linux for transparent huge pages on
-//!   large buffers (fewer page faults when a dense mesh fills hundreds of MiB).
 //!
 //! **Architecture invariant:** [`mesh`], [`topology`], [`surface`], [`continuity`],
 //! [`tessellate`], [`attributes`] and [`normals`] take slices
@@ -44,7 +42,6 @@
 pub mod attributes;
 pub mod continuity;
 pub mod gltf_io;
-pub mod huge_pages;
 pub mod mesh;
 pub mod normals;
 pub mod optimize;
