@@ -14,35 +14,51 @@ use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights};
 use super::pn::{compose, Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint, H_MAX};
 use crate::mesh::TriMesh;
-use crate::topology::{EdgeKind, Topology, Warning};
+use crate::topology::{Edge, EdgeKind, Topology, Warning};
 
 /// A control net by coordinate, `[x, y, z][control point]`: the layout the per-point sums of
 /// [`accumulate`] read, one coordinate of one control point at a time.
 type SoaNet = [[f64; 10]; 3];
 
-/// Everything one triangle needs at evaluation time.
+/// Everything one triangle needs at evaluation time, and nothing a neighbour or the mesh
+/// already holds: 352 bytes, one allocation for the whole mesh.
+///
+/// The corner positions are the net's corner points (every rule of [`Nets`] copies them in bit
+/// for bit, and the edge curves shared afterwards leave them alone); the widths are read from
+/// the surface's per-edge table through `edges`. Storing copies of either cost 96 bytes a
+/// triangle, and at a million input triangles every such byte is a page fault at set-up.
 #[derive(Debug, Clone)]
 struct Patch {
-    /// Own PN net `b_f` (Eq. 2, with shared edge curves on unblended split edges).
+    /// Own net `b_f` (Eq. 2 or the round net, with shared edge curves on unblended split
+    /// edges), by coordinate.
     net: SoaNet,
-    /// `across[k]`: for a blended edge opposite corner `k`, the neighbour and its slots, from
-    /// which [`G2Surface::across_net`] composes `b_g ∘ M` (Eq. 3) when a point needs it.
+    /// Normalized input normals at the corners (the face normal where one has no direction).
+    normal: [DVec3; 3],
+    /// `across[k]`: for a blended edge opposite corner `k` (its width above 0), the neighbour
+    /// and its slots, from which [`G2Surface::across_net`] composes `b_g ∘ M` (Eq. 3) when a
+    /// point needs it; meaningless on other edges.
     ///
     /// The composed nets are not stored: three of them per triangle were two thirds of the
     /// surface's memory (720 of 1128 bytes), more than the dense output of a level-8 triangle,
     /// and composing costs less than the page faults of holding them. Each is composed once per
     /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
     /// still agree bit for bit.
-    across: [Option<Across>; 3],
-    /// Effective width of the edge opposite each corner.
-    h: [f64; 3],
-    /// Input corner positions and normalized input normals.
-    position: [DVec3; 3],
-    normal: [DVec3; 3],
+    across: [Across; 3],
+    /// The welded edge opposite each corner, an index into [`G2Surface::effective_h`].
+    edges: [u32; 3],
+}
+
+impl Patch {
+    /// Input corner `c`'s position: the net's corner point.
+    #[inline]
+    fn corner(&self, c: usize) -> DVec3 {
+        let s = NEAR[c][c];
+        DVec3::new(self.net[0][s], self.net[1][s], self.net[2][s])
+    }
 }
 
 /// The triangle across a blended edge and the slots `[p, q, r]` of [`neighbour_map`].
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Across {
     tri: u32,
     slots: [u8; 3],
@@ -86,49 +102,37 @@ impl G2Surface {
         super::assert_belong_together(mesh, topo, h_per_edge);
 
         let (h_edge, warnings) = effective_widths(topo, h_per_edge);
-        let corners: Vec<([DVec3; 3], [DVec3; 3])> = mesh
-            .triangles
-            .par_iter()
-            .map(|tri| {
+        // Built in place, in the final array: no per-triangle corner or net arrays beside it.
+        let mut patches: Vec<Patch> = (0..mesh.triangles.len())
+            .into_par_iter()
+            .map(|t| {
+                let tri = mesh.triangles[t];
                 let position = tri.map(|c| mesh.positions[c as usize]);
                 let face = (position[1] - position[0])
                     .cross(position[2] - position[0])
                     .normalize_or(DVec3::Z);
-                (
-                    position,
-                    tri.map(|c| mesh.normals[c as usize].normalize_or(face)),
-                )
-            })
-            .collect();
-        let mut nets: Vec<Net> = corners
-            .par_iter()
-            .map(|&(p, n)| nets_rule.net(p, n))
-            .collect();
-        share_unblended_edge_curves(topo, &h_edge, &mut nets, nets_rule, &corners);
-
-        let patches: Vec<Patch> = corners
-            .par_iter()
-            .enumerate()
-            .map(|(t, &(position, normal))| {
-                let h = topo.tri_edges[t].map(|e| h_edge[e.0 as usize]);
+                let normal = tri.map(|c| mesh.normals[c as usize].normalize_or(face));
+                let edges = topo.tri_edges[t].map(|e| e.0);
                 let across = std::array::from_fn(|k| {
-                    (h[k] > 0.0).then(|| {
+                    if h_edge[edges[k] as usize] > 0.0 {
                         let n = topo.neighbours[t][k].expect("blended edges are interior");
                         Across {
                             tri: n.tri.0,
                             slots: n.slots,
                         }
-                    })
+                    } else {
+                        Across::default()
+                    }
                 });
                 Patch {
-                    net: soa(&nets[t]),
-                    across,
-                    h,
-                    position,
+                    net: soa(&nets_rule.net(position, normal)),
                     normal,
+                    across,
+                    edges,
                 }
             })
             .collect();
+        share_unblended_edge_curves(topo, &h_edge, &mut patches, nets_rule);
 
         G2Surface {
             patches,
@@ -147,12 +151,19 @@ impl G2Surface {
     /// The neighbour's net across edge `k` of `patch` in `patch`'s barycentrics, `b_g ∘ M`
     /// (Eq. 3 in the form of [`neighbour_map`]); `k` must be a blended edge.
     fn across_net(&self, patch: &Patch, k: usize) -> SoaNet {
-        let across = patch.across[k].expect("only blended edges are composed");
+        debug_assert!(self.h_edge[patch.edges[k] as usize] > 0.0, "only blended edges");
+        let across = patch.across[k];
         let g = aos(&self.patches[across.tri as usize].net);
         soa(&compose(
             &g,
             neighbour_map(k, across.slots.map(usize::from)),
         ))
+    }
+
+    /// The effective widths of `patch`'s edges, opposite corners 0, 1, 2.
+    #[inline]
+    fn widths(&self, patch: &Patch) -> [f64; 3] {
+        patch.edges.map(|e| self.h_edge[e as usize])
     }
 
     /// The profile `r(s)` in use.
@@ -263,11 +274,11 @@ fn aos(net: &SoaNet) -> Net {
 impl Surface for G2Surface {
     fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
         let patch = &self.patches[tri];
-        let w = PointWeights::at(bary, patch.h, self.profile);
+        let w = PointWeights::at(bary, self.widths(patch), self.profile);
         if let Some(c) = w.corner {
             let c = c as usize;
             return SurfacePoint {
-                position: patch.position[c],
+                position: patch.corner(c),
                 normal: patch.normal[c],
             };
         }
@@ -288,7 +299,7 @@ impl Surface for G2Surface {
     ) {
         let patch = &self.patches[tri];
         self.patterns
-            .with(level, part, patch.h, self.profile, |pattern| {
+            .with(level, part, self.widths(patch), self.profile, |pattern| {
                 let base = out.len();
                 out.resize(
                     base + pattern.len,
@@ -300,7 +311,7 @@ impl Surface for G2Surface {
                 let out = &mut out[base..];
                 for &(c, target) in &pattern.corners {
                     out[target as usize] = SurfacePoint {
-                        position: patch.position[c as usize],
+                        position: patch.corner(c as usize),
                         normal: patch.normal[c as usize],
                     };
                 }
@@ -403,54 +414,76 @@ fn effective_widths(topo: &Topology, h: &[f64]) -> (Vec<f64>, Vec<Warning>) {
 /// Makes every triangle along an unblended edge use one boundary curve: if their inner edge
 /// control points differ (split normals), each gets the average, oriented along the edge
 /// (PN-AEN); `b111` is then recomputed from the new edge points by the centre rule of `rule`
-/// (Eq. 2 for the paper's nets), with each triangle's own corner normals from `corners`.
-fn share_unblended_edge_curves(
-    topo: &Topology,
-    h_edge: &[f64],
-    nets: &mut [Net],
-    rule: Nets,
-    corners: &[([DVec3; 3], [DVec3; 3])],
-) {
-    let mut touched = vec![false; nets.len()];
-    for (edge, &h) in topo.edges.iter().zip(h_edge) {
-        if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
-            continue;
-        }
-        // Slots of the control points next to verts[0] and next to verts[1], per use.
-        let slots: Vec<(usize, [usize; 2])> = edge
-            .tris
-            .iter()
-            .map(|&(t, k)| {
-                let (k, t) = (k as usize, t.0 as usize);
-                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                let s = if topo.tri_verts[t][i] == edge.verts[0] {
-                    [NEAR[i][j], NEAR[j][i]]
-                } else {
-                    [NEAR[j][i], NEAR[i][j]]
-                };
-                (t, s)
-            })
-            .collect();
-        let first = slots[0].1.map(|s| nets[slots[0].0][s]);
-        let same = slots.iter().all(|&(t, s)| s.map(|s| nets[t][s]) == first);
-        if same {
-            continue;
-        }
-        let mut sum = [DVec3::ZERO; 2];
-        for &(t, s) in &slots {
-            sum[0] += nets[t][s[0]];
-            sum[1] += nets[t][s[1]];
-        }
-        let avg = sum.map(|x| x / slots.len() as f64);
-        for &(t, s) in &slots {
-            nets[t][s[0]] = avg[0];
-            nets[t][s[1]] = avg[1];
-            touched[t] = true;
+/// (Eq. 2 for the paper's nets), with each triangle's own corner normals.
+///
+/// Each use of an edge owns its two inner control points alone, so the edges are independent:
+/// they are compared in parallel, and only the few that differ are written afterwards, in edge
+/// order. The result does not depend on the order either way.
+fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], patches: &mut [Patch], rule: Nets) {
+    let point = |t: usize, s: usize| {
+        let net = &patches[t].net;
+        DVec3::new(net[0][s], net[1][s], net[2][s])
+    };
+    let uses = |edge| edge_uses(topo, edge);
+    let averaged: Vec<(usize, [DVec3; 2])> = topo
+        .edges
+        .par_iter()
+        .zip(h_edge)
+        .enumerate()
+        .filter_map(|(e, (edge, &h))| {
+            if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
+                return None;
+            }
+            let mut all = uses(edge);
+            let (t0, s0) = all.next()?;
+            let first = s0.map(|s| point(t0, s));
+            if all.all(|(t, s)| s.map(|s| point(t, s)) == first) {
+                return None;
+            }
+            let mut sum = [DVec3::ZERO; 2];
+            for (t, s) in uses(edge) {
+                sum[0] += point(t, s[0]);
+                sum[1] += point(t, s[1]);
+            }
+            Some((e, sum.map(|x| x / edge.tris.len() as f64)))
+        })
+        .collect();
+    if averaged.is_empty() {
+        return;
+    }
+    let mut touched = Vec::new();
+    for (e, avg) in averaged {
+        for (t, s) in uses(&topo.edges[e]) {
+            for (slot, value) in s.into_iter().zip(avg) {
+                let net = &mut patches[t].net;
+                [net[0][slot], net[1][slot], net[2][slot]] = value.to_array();
+            }
+            touched.push(t as u32);
         }
     }
-    for ((net, touched), (_, normal)) in nets.iter_mut().zip(touched).zip(corners) {
-        if touched {
-            net[B111] = rule.centre(net, *normal);
-        }
+    touched.sort_unstable();
+    touched.dedup();
+    for t in touched {
+        let patch = &mut patches[t as usize];
+        let centre = rule.centre(&aos(&patch.net), patch.normal);
+        [patch.net[0][B111], patch.net[1][B111], patch.net[2][B111]] = centre.to_array();
     }
+}
+
+/// The uses `(triangle, [slot next to verts[0], slot next to verts[1]])` of `edge`'s inner
+/// control points, in the edge's use order.
+fn edge_uses<'a>(
+    topo: &'a Topology,
+    edge: &'a Edge,
+) -> impl Iterator<Item = (usize, [usize; 2])> + 'a {
+    edge.tris.as_slice().iter().map(move |&(t, k)| {
+        let (k, t) = (k as usize, t.0 as usize);
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let s = if topo.tri_verts[t][i] == edge.verts[0] {
+            [NEAR[i][j], NEAR[j][i]]
+        } else {
+            [NEAR[j][i], NEAR[i][j]]
+        };
+        (t, s)
+    })
 }
