@@ -20,20 +20,22 @@ use crate::topology::{Edge, EdgeKind, Topology, Warning};
 /// [`accumulate`] read, one coordinate of one control point at a time.
 type SoaNet = [[f64; 10]; 3];
 
-/// Everything one triangle needs at evaluation time, and nothing a neighbour or the mesh
-/// already holds: 352 bytes, one allocation for the whole mesh.
+/// Everything one triangle needs at evaluation time that no other triangle holds too: 216
+/// bytes, one allocation for the whole mesh.
 ///
-/// The corner positions are the net's corner points (every rule of [`Nets`] copies them in bit
-/// for bit, and the edge curves shared afterwards leave them alone); the widths are read from
-/// the surface's per-edge table through `edges`. Storing copies of either cost 96 bytes a
-/// triangle, and at a million input triangles every such byte is a page fault at set-up.
+/// The corners' positions and normals live once per input vertex ([`CornerVertex`]), not
+/// once per use of it: every rule of [`Nets`] copies a corner's position into its net bit for
+/// bit and the shared edge curves leave corners alone, so the net is whole again when a
+/// lattice part asks for it ([`G2Surface::local`]). The widths are read from the surface's
+/// per-edge table through `edges`. Copies of both cost 160 bytes a triangle, and at a million
+/// input triangles every such byte is a page fault at set-up.
 #[derive(Debug, Clone)]
 struct Patch {
-    /// Own net `b_f` (Eq. 2 or the round net, with shared edge curves on unblended split
-    /// edges), by coordinate.
-    net: SoaNet,
-    /// Normalized input normals at the corners (the face normal where one has no direction).
-    normal: [DVec3; 3],
+    /// Control points 3 to 9 of the own net `b_f` (Eq. 2 or the round net, with shared edge
+    /// curves on unblended split edges), by coordinate: the six edge points and `b111`.
+    inner: [[f64; INNER]; 3],
+    /// Input vertex of each corner, an index into [`G2Surface::vertices`].
+    verts: [u32; 3],
     /// `across[k]`: for a blended edge opposite corner `k` (its width above 0), the neighbour
     /// and its slots, from which [`G2Surface::across_net`] composes `b_g ∘ M` (Eq. 3) when a
     /// point needs it; meaningless on other edges.
@@ -48,13 +50,22 @@ struct Patch {
     edges: [u32; 3],
 }
 
-impl Patch {
-    /// Input corner `c`'s position: the net's corner point.
-    #[inline]
-    fn corner(&self, c: usize) -> DVec3 {
-        let s = NEAR[c][c];
-        DVec3::new(self.net[0][s], self.net[1][s], self.net[2][s])
-    }
+/// Control points of a net that are not corners (the corners are slots 0, 1, 2).
+const INNER: usize = 7;
+
+/// An input vertex as every triangle on it reads it.
+#[derive(Debug, Clone, Copy)]
+struct CornerVertex {
+    position: DVec3,
+    /// The normalized input normal, or zero where it has no direction (each triangle then
+    /// uses its own face normal, see [`face_fallback`]).
+    normal: DVec3,
+}
+
+/// One triangle's whole net and corner normals, put together for a lattice part or a point.
+struct Local {
+    net: SoaNet,
+    normal: [DVec3; 3],
 }
 
 /// The triangle across a blended edge and the slots `[p, q, r]` of [`neighbour_map`].
@@ -68,6 +79,7 @@ struct Across {
 #[derive(Debug)]
 pub struct G2Surface {
     patches: Vec<Patch>,
+    vertices: Vec<CornerVertex>,
     profile: Profile,
     h_edge: Vec<f64>,
     warnings: Vec<Warning>,
@@ -102,16 +114,21 @@ impl G2Surface {
         super::assert_belong_together(mesh, topo, h_per_edge);
 
         let (h_edge, warnings) = effective_widths(topo, h_per_edge);
+        let vertices: Vec<CornerVertex> = mesh
+            .positions
+            .par_iter()
+            .zip(&mesh.normals)
+            .map(|(&position, normal)| CornerVertex {
+                position,
+                normal: normal.normalize_or(DVec3::ZERO),
+            })
+            .collect();
         // Built in place, in the final array: no per-triangle corner or net arrays beside it.
         let mut patches: Vec<Patch> = (0..mesh.triangles.len())
             .into_par_iter()
             .map(|t| {
-                let tri = mesh.triangles[t];
-                let position = tri.map(|c| mesh.positions[c as usize]);
-                let face = (position[1] - position[0])
-                    .cross(position[2] - position[0])
-                    .normalize_or(DVec3::Z);
-                let normal = tri.map(|c| mesh.normals[c as usize].normalize_or(face));
+                let verts = mesh.triangles[t];
+                let (position, normal) = corners(&vertices, verts);
                 let edges = topo.tri_edges[t].map(|e| e.0);
                 let across = std::array::from_fn(|k| {
                     if h_edge[edges[k] as usize] > 0.0 {
@@ -124,18 +141,20 @@ impl G2Surface {
                         Across::default()
                     }
                 });
+                let net = soa(&nets_rule.net(position, normal));
                 Patch {
-                    net: soa(&nets_rule.net(position, normal)),
-                    normal,
+                    inner: net.map(|c| std::array::from_fn(|m| c[3 + m])),
+                    verts,
                     across,
                     edges,
                 }
             })
             .collect();
-        share_unblended_edge_curves(topo, &h_edge, &mut patches, nets_rule);
+        share_unblended_edge_curves(topo, &h_edge, &vertices, &mut patches, nets_rule);
 
         G2Surface {
             patches,
+            vertices,
             profile,
             h_edge,
             warnings,
@@ -153,11 +172,18 @@ impl G2Surface {
     fn across_net(&self, patch: &Patch, k: usize) -> SoaNet {
         debug_assert!(self.h_edge[patch.edges[k] as usize] > 0.0, "only blended edges");
         let across = patch.across[k];
-        let g = aos(&self.patches[across.tri as usize].net);
+        let g = aos(&self.local(across.tri as usize).net);
         soa(&compose(
             &g,
             neighbour_map(k, across.slots.map(usize::from)),
         ))
+    }
+
+    /// Triangle `tri`'s whole net and corner normals, exactly as they were when its net was
+    /// made.
+    #[inline]
+    fn local(&self, tri: usize) -> Local {
+        local(&self.vertices, &self.patches[tri])
     }
 
     /// The effective widths of `patch`'s edges, opposite corners 0, 1, 2.
@@ -186,7 +212,7 @@ impl G2Surface {
     /// point agree bit for bit.
     #[inline(always)]
     fn combine<const L: usize>(
-        patch: &Patch,
+        normal: &[DVec3; 3],
         w: &Lanes<L>,
         own: &Broadcast<L>,
         across: Option<&Broadcast<L>>,
@@ -200,7 +226,7 @@ impl G2Surface {
             let (position, du, dv) = (v(0), v(1), v(2));
             let b = w.bary[l];
             let interpolated =
-                b[0] * patch.normal[0] + b[1] * patch.normal[1] + b[2] * patch.normal[2];
+                b[0] * normal[0] + b[1] * normal[1] + b[2] * normal[2];
             let n = du.cross(dv);
             let len2 = n.length_squared();
             // |N| ≤ 1e-14·|∂_u S|·|∂_v S|: the tangents are parallel to rounding (a degenerate
@@ -214,7 +240,7 @@ impl G2Surface {
                         n
                     }
                 } else {
-                    interpolated.normalize_or(patch.normal[0])
+                    interpolated.normalize_or(normal[0])
                 };
             SurfacePoint { position, normal }
         })
@@ -271,22 +297,64 @@ fn aos(net: &SoaNet) -> Net {
     std::array::from_fn(|m| DVec3::new(net[0][m], net[1][m], net[2][m]))
 }
 
+/// Corner `c`'s position in a net.
+#[inline]
+fn corner(net: &SoaNet, c: usize) -> DVec3 {
+    DVec3::new(net[0][c], net[1][c], net[2][c])
+}
+
+/// Positions and unit normals of the corners `verts` as the net rules take them: the
+/// normalized input normals, and the face normal where one has no direction.
+#[inline]
+fn corners(vertices: &[CornerVertex], verts: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
+    let v = verts.map(|v| vertices[v as usize]);
+    let position = v.map(|v| v.position);
+    let face = face_fallback(position);
+    (
+        position,
+        v.map(|v| if v.normal == DVec3::ZERO { face } else { v.normal }),
+    )
+}
+
+/// The unit face normal of a triangle (+z if it has none): the corner normal of an input
+/// vertex whose normal has no direction.
+#[inline]
+fn face_fallback(p: [DVec3; 3]) -> DVec3 {
+    (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(DVec3::Z)
+}
+
+/// A patch's whole net and corner normals (see [`G2Surface::local`]).
+#[inline]
+fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
+    let (position, normal) = corners(vertices, patch.verts);
+    let net = std::array::from_fn(|x| {
+        let mut coord = [0.0; 10];
+        for c in 0..3 {
+            coord[c] = position[c][x];
+        }
+        coord[3..].copy_from_slice(&patch.inner[x]);
+        coord
+    });
+    Local { net, normal }
+}
+
 impl Surface for G2Surface {
     fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
         let patch = &self.patches[tri];
         let w = PointWeights::at(bary, self.widths(patch), self.profile);
+        let local = self.local(tri);
         if let Some(c) = w.corner {
             let c = c as usize;
             return SurfacePoint {
-                position: patch.corner(c),
-                normal: patch.normal[c],
+                position: corner(&local.net, c),
+                normal: local.normal[c],
             };
         }
-        let own = broadcast(&patch.net);
+        let own = broadcast(&local.net);
         let across = w
             .blended
             .then(|| broadcast(&self.across_net(patch, w.k as usize)));
-        let [p] = Self::combine(patch, &Lanes::<1>::single(&w), &own, across.as_ref());
+        let [p] = Self::combine(&local.normal, &Lanes::<1>::single(&w), &own, across.as_ref());
         p
     }
 
@@ -298,6 +366,7 @@ impl Surface for G2Surface {
         out: &mut Vec<SurfacePoint>,
     ) {
         let patch = &self.patches[tri];
+        let local = self.local(tri);
         self.patterns
             .with(level, part, self.widths(patch), self.profile, |pattern| {
                 let base = out.len();
@@ -311,11 +380,11 @@ impl Surface for G2Surface {
                 let out = &mut out[base..];
                 for &(c, target) in &pattern.corners {
                     out[target as usize] = SurfacePoint {
-                        position: patch.corner(c as usize),
-                        normal: patch.normal[c as usize],
+                        position: corner(&local.net, c as usize),
+                        normal: local.normal[c as usize],
                     };
                 }
-                let own = broadcast(&patch.net);
+                let own = broadcast(&local.net);
                 let groups = std::iter::once((None, &pattern.plain))
                     .chain((0..3).map(|k| (Some(k), &pattern.blended[k])));
                 for (k, blocks) in groups {
@@ -324,7 +393,8 @@ impl Surface for G2Surface {
                     }
                     let across = k.map(|k| broadcast(&self.across_net(patch, k)));
                     for lanes in blocks {
-                        let points = Self::combine(patch, lanes, &own, across.as_ref());
+                        let points =
+                            Self::combine(&local.normal, lanes, &own, across.as_ref());
                         for (&target, p) in lanes.target.iter().zip(points) {
                             if target != Lanes::<1>::PADDING {
                                 out[target as usize] = p;
@@ -419,10 +489,17 @@ fn effective_widths(topo: &Topology, h: &[f64]) -> (Vec<f64>, Vec<Warning>) {
 /// Each use of an edge owns its two inner control points alone, so the edges are independent:
 /// they are compared in parallel, and only the few that differ are written afterwards, in edge
 /// order. The result does not depend on the order either way.
-fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], patches: &mut [Patch], rule: Nets) {
+fn share_unblended_edge_curves(
+    topo: &Topology,
+    h_edge: &[f64],
+    vertices: &[CornerVertex],
+    patches: &mut [Patch],
+    rule: Nets,
+) {
+    // Edge points only: never a corner.
     let point = |t: usize, s: usize| {
-        let net = &patches[t].net;
-        DVec3::new(net[0][s], net[1][s], net[2][s])
+        let inner = &patches[t].inner;
+        DVec3::new(inner[0][s - 3], inner[1][s - 3], inner[2][s - 3])
     };
     let uses = |edge| edge_uses(topo, edge);
     let averaged: Vec<(usize, [DVec3; 2])> = topo
@@ -455,8 +532,8 @@ fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], patches: &mut [P
     for (e, avg) in averaged {
         for (t, s) in uses(&topo.edges[e]) {
             for (slot, value) in s.into_iter().zip(avg) {
-                let net = &mut patches[t].net;
-                [net[0][slot], net[1][slot], net[2][slot]] = value.to_array();
+                let inner = &mut patches[t].inner;
+                [inner[0][slot - 3], inner[1][slot - 3], inner[2][slot - 3]] = value.to_array();
             }
             touched.push(t as u32);
         }
@@ -465,8 +542,10 @@ fn share_unblended_edge_curves(topo: &Topology, h_edge: &[f64], patches: &mut [P
     touched.dedup();
     for t in touched {
         let patch = &mut patches[t as usize];
-        let centre = rule.centre(&aos(&patch.net), patch.normal);
-        [patch.net[0][B111], patch.net[1][B111], patch.net[2][B111]] = centre.to_array();
+        let Local { net, normal } = local(vertices, patch);
+        let centre = rule.centre(&aos(&net), normal);
+        let b = B111 - 3;
+        [patch.inner[0][b], patch.inner[1][b], patch.inner[2][b]] = centre.to_array();
     }
 }
 
