@@ -170,7 +170,10 @@ impl G2Surface {
     /// The neighbour's net across edge `k` of `patch` in `patch`'s barycentrics, `b_g ∘ M`
     /// (Eq. 3 in the form of [`neighbour_map`]); `k` must be a blended edge.
     fn across_net(&self, patch: &Patch, k: usize) -> SoaNet {
-        debug_assert!(self.h_edge[patch.edges[k] as usize] > 0.0, "only blended edges");
+        debug_assert!(
+            self.h_edge[patch.edges[k] as usize] > 0.0,
+            "only blended edges"
+        );
         let across = patch.across[k];
         let g = aos(&self.local(across.tri as usize).net);
         soa(&compose(
@@ -225,8 +228,7 @@ impl G2Surface {
             let v = |q: usize| DVec3::new(acc[q][0][l], acc[q][1][l], acc[q][2][l]);
             let (position, du, dv) = (v(0), v(1), v(2));
             let b = w.bary[l];
-            let interpolated =
-                b[0] * normal[0] + b[1] * normal[1] + b[2] * normal[2];
+            let interpolated = b[0] * normal[0] + b[1] * normal[1] + b[2] * normal[2];
             let n = du.cross(dv);
             let len2 = n.length_squared();
             // |N| ≤ 1e-14·|∂_u S|·|∂_v S|: the tangents are parallel to rounding (a degenerate
@@ -312,7 +314,13 @@ fn corners(vertices: &[CornerVertex], verts: [u32; 3]) -> ([DVec3; 3], [DVec3; 3
     let face = face_fallback(position);
     (
         position,
-        v.map(|v| if v.normal == DVec3::ZERO { face } else { v.normal }),
+        v.map(|v| {
+            if v.normal == DVec3::ZERO {
+                face
+            } else {
+                v.normal
+            }
+        }),
     )
 }
 
@@ -354,7 +362,12 @@ impl Surface for G2Surface {
         let across = w
             .blended
             .then(|| broadcast(&self.across_net(patch, w.k as usize)));
-        let [p] = Self::combine(&local.normal, &Lanes::<1>::single(&w), &own, across.as_ref());
+        let [p] = Self::combine(
+            &local.normal,
+            &Lanes::<1>::single(&w),
+            &own,
+            across.as_ref(),
+        );
         p
     }
 
@@ -393,8 +406,7 @@ impl Surface for G2Surface {
                     }
                     let across = k.map(|k| broadcast(&self.across_net(patch, k)));
                     for lanes in blocks {
-                        let points =
-                            Self::combine(&local.normal, lanes, &own, across.as_ref());
+                        let points = Self::combine(&local.normal, lanes, &own, across.as_ref());
                         for (&target, p) in lanes.target.iter().zip(points) {
                             if target != Lanes::<1>::PADDING {
                                 out[target as usize] = p;
