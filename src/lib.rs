@@ -31,8 +31,6 @@
 //!   each fallback a stage takes reaches its report as a typed [`pipeline::Warning`].
 //! - [`render`]: pictures of any document on the CPU (shaded, zebra, flat, and the input's
 //!   edges coloured by h), side by side with one camera, as PNG.
-//! - [`huge_pages`]: the binary's allocator, which asks Linux for transparent huge pages on
-//!   large buffers (fewer page faults when a dense mesh fills hundreds of MiB).
 //!
 //! **Architecture invariant:** [`mesh`], [`topology`], [`surface`], [`continuity`],
 //! [`tessellate`], [`attributes`] and [`normals`] take slices
@@ -45,7 +43,6 @@
 pub mod attributes;
 pub mod continuity;
 pub mod gltf_io;
-pub mod huge_pages;
 pub mod mesh;
 pub mod normals;
 pub mod optimize;

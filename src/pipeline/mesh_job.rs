@@ -194,7 +194,7 @@ pub fn smooth_mesh(
         &dense,
         options.report_figures,
     );
-    // The surface holds about 1 kB per input triangle: free it before the attributes are
+    // The G² surface holds about 240 bytes per input triangle: free it before the attributes are
     // carried, when the dense mesh is at its largest.
     drop(surface);
     stop_if_cancelled(options, asset)?;

@@ -14,35 +14,62 @@ use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights};
 use super::pn::{compose, Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint, H_MAX};
 use crate::mesh::TriMesh;
-use crate::topology::{EdgeKind, Topology, Warning};
+use crate::topology::{Edge, EdgeKind, Topology, Warning};
 
 /// A control net by coordinate, `[x, y, z][control point]`: the layout the per-point sums of
 /// [`accumulate`] read, one coordinate of one control point at a time.
 type SoaNet = [[f64; 10]; 3];
 
-/// Everything one triangle needs at evaluation time.
+/// Everything one triangle needs at evaluation time that no other triangle holds too: 216
+/// bytes, one allocation for the whole mesh.
+///
+/// The corners' positions and normals live once per input vertex ([`CornerVertex`]), not
+/// once per use of it: every rule of [`Nets`] copies a corner's position into its net bit for
+/// bit and the shared edge curves leave corners alone, so the net is whole again when a
+/// lattice part asks for it ([`G2Surface::local`]). The widths are read from the surface's
+/// per-edge table through `edges`. Copies of both cost 160 bytes a triangle, and at a million
+/// input triangles every such byte is a page fault at set-up.
 #[derive(Debug, Clone)]
 struct Patch {
-    /// Own PN net `b_f` (Eq. 2, with shared edge curves on unblended split edges).
-    net: SoaNet,
-    /// `across[k]`: for a blended edge opposite corner `k`, the neighbour and its slots, from
-    /// which [`G2Surface::across_net`] composes `b_g ∘ M` (Eq. 3) when a point needs it.
+    /// Control points 3 to 9 of the own net `b_f` (Eq. 2 or the round net, with shared edge
+    /// curves on unblended split edges), by coordinate: the six edge points and `b111`.
+    inner: [[f64; INNER]; 3],
+    /// Input vertex of each corner, an index into [`G2Surface::vertices`].
+    verts: [u32; 3],
+    /// `across[k]`: for a blended edge opposite corner `k` (its width above 0), the neighbour
+    /// and its slots, from which [`G2Surface::across_net`] composes `b_g ∘ M` (Eq. 3) when a
+    /// point needs it; meaningless on other edges.
     ///
     /// The composed nets are not stored: three of them per triangle were two thirds of the
     /// surface's memory (720 of 1128 bytes), more than the dense output of a level-8 triangle,
     /// and composing costs less than the page faults of holding them. Each is composed once per
     /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
     /// still agree bit for bit.
-    across: [Option<Across>; 3],
-    /// Effective width of the edge opposite each corner.
-    h: [f64; 3],
-    /// Input corner positions and normalized input normals.
-    position: [DVec3; 3],
+    across: [Across; 3],
+    /// The welded edge opposite each corner, an index into [`G2Surface::effective_h`].
+    edges: [u32; 3],
+}
+
+/// Control points of a net that are not corners (the corners are slots 0, 1, 2).
+const INNER: usize = 7;
+
+/// An input vertex as every triangle on it reads it.
+#[derive(Debug, Clone, Copy)]
+struct CornerVertex {
+    position: DVec3,
+    /// The normalized input normal, or zero where it has no direction (each triangle then
+    /// uses its own face normal, see [`face_fallback`]).
+    normal: DVec3,
+}
+
+/// One triangle's whole net and corner normals, put together for a lattice part or a point.
+struct Local {
+    net: SoaNet,
     normal: [DVec3; 3],
 }
 
 /// The triangle across a blended edge and the slots `[p, q, r]` of [`neighbour_map`].
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Across {
     tri: u32,
     slots: [u8; 3],
@@ -52,6 +79,7 @@ struct Across {
 #[derive(Debug)]
 pub struct G2Surface {
     patches: Vec<Patch>,
+    vertices: Vec<CornerVertex>,
     profile: Profile,
     h_edge: Vec<f64>,
     warnings: Vec<Warning>,
@@ -86,52 +114,47 @@ impl G2Surface {
         super::assert_belong_together(mesh, topo, h_per_edge);
 
         let (h_edge, warnings) = effective_widths(topo, h_per_edge);
-        let corners: Vec<([DVec3; 3], [DVec3; 3])> = mesh
-            .triangles
+        let vertices: Vec<CornerVertex> = mesh
+            .positions
             .par_iter()
-            .map(|tri| {
-                let position = tri.map(|c| mesh.positions[c as usize]);
-                let face = (position[1] - position[0])
-                    .cross(position[2] - position[0])
-                    .normalize_or(DVec3::Z);
-                (
-                    position,
-                    tri.map(|c| mesh.normals[c as usize].normalize_or(face)),
-                )
+            .zip(&mesh.normals)
+            .map(|(&position, normal)| CornerVertex {
+                position,
+                normal: normal.normalize_or(DVec3::ZERO),
             })
             .collect();
-        let mut nets: Vec<Net> = corners
-            .par_iter()
-            .map(|&(p, n)| nets_rule.net(p, n))
-            .collect();
-        share_unblended_edge_curves(topo, &h_edge, &mut nets, nets_rule, &corners);
-
-        let patches: Vec<Patch> = corners
-            .par_iter()
-            .enumerate()
-            .map(|(t, &(position, normal))| {
-                let h = topo.tri_edges[t].map(|e| h_edge[e.0 as usize]);
+        // Built in place, in the final array: no per-triangle corner or net arrays beside it.
+        let mut patches: Vec<Patch> = (0..mesh.triangles.len())
+            .into_par_iter()
+            .map(|t| {
+                let verts = mesh.triangles[t];
+                let (position, normal) = corners(&vertices, verts);
+                let edges = topo.tri_edges[t].map(|e| e.0);
                 let across = std::array::from_fn(|k| {
-                    (h[k] > 0.0).then(|| {
+                    if h_edge[edges[k] as usize] > 0.0 {
                         let n = topo.neighbours[t][k].expect("blended edges are interior");
                         Across {
                             tri: n.tri.0,
                             slots: n.slots,
                         }
-                    })
+                    } else {
+                        Across::default()
+                    }
                 });
+                let net = soa(&nets_rule.net(position, normal));
                 Patch {
-                    net: soa(&nets[t]),
+                    inner: net.map(|c| std::array::from_fn(|m| c[3 + m])),
+                    verts,
                     across,
-                    h,
-                    position,
-                    normal,
+                    edges,
                 }
             })
             .collect();
+        share_unblended_edge_curves(topo, &h_edge, &vertices, &mut patches, nets_rule);
 
         G2Surface {
             patches,
+            vertices,
             profile,
             h_edge,
             warnings,
@@ -147,12 +170,29 @@ impl G2Surface {
     /// The neighbour's net across edge `k` of `patch` in `patch`'s barycentrics, `b_g ∘ M`
     /// (Eq. 3 in the form of [`neighbour_map`]); `k` must be a blended edge.
     fn across_net(&self, patch: &Patch, k: usize) -> SoaNet {
-        let across = patch.across[k].expect("only blended edges are composed");
-        let g = aos(&self.patches[across.tri as usize].net);
+        debug_assert!(
+            self.h_edge[patch.edges[k] as usize] > 0.0,
+            "only blended edges"
+        );
+        let across = patch.across[k];
+        let g = aos(&self.local(across.tri as usize).net);
         soa(&compose(
             &g,
             neighbour_map(k, across.slots.map(usize::from)),
         ))
+    }
+
+    /// Triangle `tri`'s whole net and corner normals, exactly as they were when its net was
+    /// made.
+    #[inline]
+    fn local(&self, tri: usize) -> Local {
+        local(&self.vertices, &self.patches[tri])
+    }
+
+    /// The effective widths of `patch`'s edges, opposite corners 0, 1, 2.
+    #[inline]
+    fn widths(&self, patch: &Patch) -> [f64; 3] {
+        patch.edges.map(|e| self.h_edge[e as usize])
     }
 
     /// The profile `r(s)` in use.
@@ -175,7 +215,7 @@ impl G2Surface {
     /// point agree bit for bit.
     #[inline(always)]
     fn combine<const L: usize>(
-        patch: &Patch,
+        normal: &[DVec3; 3],
         w: &Lanes<L>,
         own: &Broadcast<L>,
         across: Option<&Broadcast<L>>,
@@ -188,8 +228,7 @@ impl G2Surface {
             let v = |q: usize| DVec3::new(acc[q][0][l], acc[q][1][l], acc[q][2][l]);
             let (position, du, dv) = (v(0), v(1), v(2));
             let b = w.bary[l];
-            let interpolated =
-                b[0] * patch.normal[0] + b[1] * patch.normal[1] + b[2] * patch.normal[2];
+            let interpolated = b[0] * normal[0] + b[1] * normal[1] + b[2] * normal[2];
             let n = du.cross(dv);
             let len2 = n.length_squared();
             // |N| ≤ 1e-14·|∂_u S|·|∂_v S|: the tangents are parallel to rounding (a degenerate
@@ -203,7 +242,7 @@ impl G2Surface {
                         n
                     }
                 } else {
-                    interpolated.normalize_or(patch.normal[0])
+                    interpolated.normalize_or(normal[0])
                 };
             SurfacePoint { position, normal }
         })
@@ -260,22 +299,75 @@ fn aos(net: &SoaNet) -> Net {
     std::array::from_fn(|m| DVec3::new(net[0][m], net[1][m], net[2][m]))
 }
 
+/// Corner `c`'s position in a net.
+#[inline]
+fn corner(net: &SoaNet, c: usize) -> DVec3 {
+    DVec3::new(net[0][c], net[1][c], net[2][c])
+}
+
+/// Positions and unit normals of the corners `verts` as the net rules take them: the
+/// normalized input normals, and the face normal where one has no direction.
+#[inline]
+fn corners(vertices: &[CornerVertex], verts: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
+    let v = verts.map(|v| vertices[v as usize]);
+    let position = v.map(|v| v.position);
+    let face = face_fallback(position);
+    (
+        position,
+        v.map(|v| {
+            if v.normal == DVec3::ZERO {
+                face
+            } else {
+                v.normal
+            }
+        }),
+    )
+}
+
+/// The unit face normal of a triangle (+z if it has none): the corner normal of an input
+/// vertex whose normal has no direction.
+#[inline]
+fn face_fallback(p: [DVec3; 3]) -> DVec3 {
+    (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(DVec3::Z)
+}
+
+/// A patch's whole net and corner normals (see [`G2Surface::local`]).
+#[inline]
+fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
+    let (position, normal) = corners(vertices, patch.verts);
+    let net = std::array::from_fn(|x| {
+        let mut coord = [0.0; 10];
+        for c in 0..3 {
+            coord[c] = position[c][x];
+        }
+        coord[3..].copy_from_slice(&patch.inner[x]);
+        coord
+    });
+    Local { net, normal }
+}
+
 impl Surface for G2Surface {
     fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
         let patch = &self.patches[tri];
-        let w = PointWeights::at(bary, patch.h, self.profile);
+        let w = PointWeights::at(bary, self.widths(patch), self.profile);
+        let local = self.local(tri);
         if let Some(c) = w.corner {
             let c = c as usize;
             return SurfacePoint {
-                position: patch.position[c],
-                normal: patch.normal[c],
+                position: corner(&local.net, c),
+                normal: local.normal[c],
             };
         }
-        let own = broadcast(&patch.net);
+        let own = broadcast(&local.net);
         let across = w
             .blended
             .then(|| broadcast(&self.across_net(patch, w.k as usize)));
-        let [p] = Self::combine(patch, &Lanes::<1>::single(&w), &own, across.as_ref());
+        let [p] = Self::combine(
+            &local.normal,
+            &Lanes::<1>::single(&w),
+            &own,
+            across.as_ref(),
+        );
         p
     }
 
@@ -287,8 +379,9 @@ impl Surface for G2Surface {
         out: &mut Vec<SurfacePoint>,
     ) {
         let patch = &self.patches[tri];
+        let local = self.local(tri);
         self.patterns
-            .with(level, part, patch.h, self.profile, |pattern| {
+            .with(level, part, self.widths(patch), self.profile, |pattern| {
                 let base = out.len();
                 out.resize(
                     base + pattern.len,
@@ -300,11 +393,11 @@ impl Surface for G2Surface {
                 let out = &mut out[base..];
                 for &(c, target) in &pattern.corners {
                     out[target as usize] = SurfacePoint {
-                        position: patch.position[c as usize],
-                        normal: patch.normal[c as usize],
+                        position: corner(&local.net, c as usize),
+                        normal: local.normal[c as usize],
                     };
                 }
-                let own = broadcast(&patch.net);
+                let own = broadcast(&local.net);
                 let groups = std::iter::once((None, &pattern.plain))
                     .chain((0..3).map(|k| (Some(k), &pattern.blended[k])));
                 for (k, blocks) in groups {
@@ -313,7 +406,7 @@ impl Surface for G2Surface {
                     }
                     let across = k.map(|k| broadcast(&self.across_net(patch, k)));
                     for lanes in blocks {
-                        let points = Self::combine(patch, lanes, &own, across.as_ref());
+                        let points = Self::combine(&local.normal, lanes, &own, across.as_ref());
                         for (&target, p) in lanes.target.iter().zip(points) {
                             if target != Lanes::<1>::PADDING {
                                 out[target as usize] = p;
@@ -403,54 +496,85 @@ fn effective_widths(topo: &Topology, h: &[f64]) -> (Vec<f64>, Vec<Warning>) {
 /// Makes every triangle along an unblended edge use one boundary curve: if their inner edge
 /// control points differ (split normals), each gets the average, oriented along the edge
 /// (PN-AEN); `b111` is then recomputed from the new edge points by the centre rule of `rule`
-/// (Eq. 2 for the paper's nets), with each triangle's own corner normals from `corners`.
+/// (Eq. 2 for the paper's nets), with each triangle's own corner normals.
+///
+/// Each use of an edge owns its two inner control points alone, so the edges are independent:
+/// they are compared in parallel, and only the few that differ are written afterwards, in edge
+/// order. The result does not depend on the order either way.
 fn share_unblended_edge_curves(
     topo: &Topology,
     h_edge: &[f64],
-    nets: &mut [Net],
+    vertices: &[CornerVertex],
+    patches: &mut [Patch],
     rule: Nets,
-    corners: &[([DVec3; 3], [DVec3; 3])],
 ) {
-    let mut touched = vec![false; nets.len()];
-    for (edge, &h) in topo.edges.iter().zip(h_edge) {
-        if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
-            continue;
-        }
-        // Slots of the control points next to verts[0] and next to verts[1], per use.
-        let slots: Vec<(usize, [usize; 2])> = edge
-            .tris
-            .iter()
-            .map(|&(t, k)| {
-                let (k, t) = (k as usize, t.0 as usize);
-                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                let s = if topo.tri_verts[t][i] == edge.verts[0] {
-                    [NEAR[i][j], NEAR[j][i]]
-                } else {
-                    [NEAR[j][i], NEAR[i][j]]
-                };
-                (t, s)
-            })
-            .collect();
-        let first = slots[0].1.map(|s| nets[slots[0].0][s]);
-        let same = slots.iter().all(|&(t, s)| s.map(|s| nets[t][s]) == first);
-        if same {
-            continue;
-        }
-        let mut sum = [DVec3::ZERO; 2];
-        for &(t, s) in &slots {
-            sum[0] += nets[t][s[0]];
-            sum[1] += nets[t][s[1]];
-        }
-        let avg = sum.map(|x| x / slots.len() as f64);
-        for &(t, s) in &slots {
-            nets[t][s[0]] = avg[0];
-            nets[t][s[1]] = avg[1];
-            touched[t] = true;
+    // Edge points only: never a corner.
+    let point = |t: usize, s: usize| {
+        let inner = &patches[t].inner;
+        DVec3::new(inner[0][s - 3], inner[1][s - 3], inner[2][s - 3])
+    };
+    let uses = |edge| edge_uses(topo, edge);
+    let averaged: Vec<(usize, [DVec3; 2])> = topo
+        .edges
+        .par_iter()
+        .zip(h_edge)
+        .enumerate()
+        .filter_map(|(e, (edge, &h))| {
+            if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
+                return None;
+            }
+            let mut all = uses(edge);
+            let (t0, s0) = all.next()?;
+            let first = s0.map(|s| point(t0, s));
+            if all.all(|(t, s)| s.map(|s| point(t, s)) == first) {
+                return None;
+            }
+            let mut sum = [DVec3::ZERO; 2];
+            for (t, s) in uses(edge) {
+                sum[0] += point(t, s[0]);
+                sum[1] += point(t, s[1]);
+            }
+            Some((e, sum.map(|x| x / edge.tris.len() as f64)))
+        })
+        .collect();
+    if averaged.is_empty() {
+        return;
+    }
+    let mut touched = Vec::new();
+    for (e, avg) in averaged {
+        for (t, s) in uses(&topo.edges[e]) {
+            for (slot, value) in s.into_iter().zip(avg) {
+                let inner = &mut patches[t].inner;
+                [inner[0][slot - 3], inner[1][slot - 3], inner[2][slot - 3]] = value.to_array();
+            }
+            touched.push(t as u32);
         }
     }
-    for ((net, touched), (_, normal)) in nets.iter_mut().zip(touched).zip(corners) {
-        if touched {
-            net[B111] = rule.centre(net, *normal);
-        }
+    touched.sort_unstable();
+    touched.dedup();
+    for t in touched {
+        let patch = &mut patches[t as usize];
+        let Local { net, normal } = local(vertices, patch);
+        let centre = rule.centre(&aos(&net), normal);
+        let b = B111 - 3;
+        [patch.inner[0][b], patch.inner[1][b], patch.inner[2][b]] = centre.to_array();
     }
+}
+
+/// The uses `(triangle, [slot next to verts[0], slot next to verts[1]])` of `edge`'s inner
+/// control points, in the edge's use order.
+fn edge_uses<'a>(
+    topo: &'a Topology,
+    edge: &'a Edge,
+) -> impl Iterator<Item = (usize, [usize; 2])> + 'a {
+    edge.tris.as_slice().iter().map(move |&(t, k)| {
+        let (k, t) = (k as usize, t.0 as usize);
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let s = if topo.tri_verts[t][i] == edge.verts[0] {
+            [NEAR[i][j], NEAR[j][i]]
+        } else {
+            [NEAR[j][i], NEAR[i][j]]
+        };
+        (t, s)
+    })
 }
