@@ -69,16 +69,31 @@ impl Curvature {
         interior_index(l, i, j)
     }
 
-    /// The largest predicted error of the level-`m` lattice's own triangles (every triangle of
-    /// a uniform lattice has edges along the three lattice directions, one step long), over the
-    /// whole source triangle.
+    /// The largest predicted error of the inner lattice of a level-`m` pattern (every triangle
+    /// of a uniform lattice has edges along the three lattice directions, one step long): over
+    /// the points at least one level-`m` step in from every edge, where its triangles are; none
+    /// below level 4, where every triangle touches the boundary.
     pub fn lattice_error(&self, m: u32) -> f64 {
-        let scale = (f64::from(self.level) / f64::from(m)).powi(2);
-        let worst = self
-            .at
-            .iter()
-            .map(|d| worst_squared(*d))
-            .fold(0.0f64, f64::max);
+        if m < 4 && m != self.level {
+            return 0.0;
+        }
+        let l = self.level;
+        let inside = |i: u32, j: u32| {
+            // Barycentrics i/l, j/l and (l − i − j)/l each at least 1/m (or the whole
+            // interior when m is the lattice's own level).
+            m == l || (i * m >= l && j * m >= l && (l - i - j) * m >= l)
+        };
+        let mut worst = 0.0f64;
+        let mut index = 0;
+        for j in 1..l {
+            for i in 1..l - j {
+                if inside(i, j) {
+                    worst = worst.max(worst_squared(self.at[index]));
+                }
+                index += 1;
+            }
+        }
+        let scale = (f64::from(l) / f64::from(m)).powi(2);
         scale * worst.sqrt()
     }
 
