@@ -371,6 +371,31 @@ impl Surface for G2Surface {
         p
     }
 
+    /// [`Surface::evaluate`] point by point, with the own net broadcast and each neighbour's
+    /// net composed once for all of them instead of once per point.
+    fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
+        let patch = &self.patches[tri];
+        let own = broadcast(&patch.net);
+        let mut across: [Option<Broadcast<1>>; 3] = [None; 3];
+        out.reserve(barys.len());
+        for &bary in barys {
+            let w = PointWeights::at(bary, patch.h, self.profile);
+            if let Some(c) = w.corner {
+                out.push(SurfacePoint {
+                    position: patch.position[c as usize],
+                    normal: patch.normal[c as usize],
+                });
+                continue;
+            }
+            let net = w.blended.then(|| {
+                let k = w.k as usize;
+                &*across[k].get_or_insert_with(|| broadcast(&self.across_net(patch, k)))
+            });
+            let [p] = Self::combine(patch, &Lanes::<1>::single(&w), &own, net);
+            out.push(p);
+        }
+    }
+
     fn evaluate_lattice_part(
         &self,
         tri: usize,
@@ -456,6 +481,10 @@ impl Surface for PnSurface {
         out: &mut Vec<SurfacePoint>,
     ) {
         self.0.evaluate_lattice_part(tri, level, part, out)
+    }
+
+    fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
+        self.0.evaluate_points(tri, barys, out)
     }
 }
 

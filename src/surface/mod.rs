@@ -116,6 +116,13 @@ pub trait Surface: Sync {
         self.evaluate_lattice_points(tri, level, &part.points(level), out);
     }
 
+    /// The points at barycentrics `barys` of triangle `tri`, appended to `out` in order; equal to
+    /// [`Surface::evaluate`] bit for bit. Many points of one triangle at once let a surface do
+    /// its per-triangle work once (the chord error measurement asks for thousands).
+    fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
+        out.extend(barys.iter().map(|&b| self.evaluate(tri, b)));
+    }
+
     /// Some points `(i, j)` of the level-`level` lattice of triangle `tri`, appended to `out` in
     /// the order given; equal to [`Surface::evaluate`] at [`lattice_bary`] bit for bit.
     fn evaluate_lattice_points(

@@ -17,13 +17,14 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::counts::SegmentCounts;
+use super::estimate::PatternError;
 use super::transition::{Pattern, PatternKey};
 use super::DenseMesh;
-use crate::surface::Surface;
+use crate::surface::{LatticePart, Surface, SurfacePoint};
 use crate::topology::Topology;
 
 /// Sample weights inside each output triangle.
-const WEIGHTS: [[f64; 3]; 7] = [
+pub(super) const WEIGHTS: [[f64; 3]; 7] = [
     [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
     [0.5, 0.5, 0.0],
     [0.0, 0.5, 0.5],
@@ -61,14 +62,63 @@ pub fn chord_error(
     let position = |v: u32| DVec3::from(dense.positions[v as usize].map(f64::from));
     (0..keys.len())
         .into_par_iter()
-        .map(|offset| {
+        .map_init(Samples::default, |samples, offset| {
             let pattern = &patterns[&keys[offset]];
             let indices = &dense.indices[first_index[offset]..];
-            pattern_error(surface, group.start + offset, pattern, |t, c| {
-                position(indices[3 * t + c])
-            })
+            pattern_error(
+                surface,
+                group.start + offset,
+                pattern,
+                |t, c| position(indices[3 * t + c]),
+                samples,
+            )
         })
         .reduce(|| 0.0, f64::max)
+}
+
+/// Scratch buffers of [`pattern_error`] and [`measured_error`], kept per thread.
+#[derive(Debug, Default)]
+pub(crate) struct Samples {
+    barys: Vec<[f64; 3]>,
+    points: Vec<SurfacePoint>,
+    vertices: Vec<DVec3>,
+}
+
+/// Calls `each(t, error)` with the chord error of every output triangle `t` of source triangle
+/// `tri` cut by `pattern`, whose corner `c` is at `corner(t, c)`. The sample points of all of
+/// them are evaluated in one call, so the surface does its per-triangle work once.
+fn triangle_errors(
+    surface: &dyn Surface,
+    tri: usize,
+    pattern: &Pattern,
+    corner: impl Fn(usize, usize) -> DVec3,
+    samples: &mut Samples,
+    mut each: impl FnMut(usize, f64),
+) {
+    samples.barys.clear();
+    for points in &pattern.triangles {
+        let bary = points.map(|p| pattern.bary(p));
+        for w in WEIGHTS {
+            let mut domain = [0.0; 3];
+            for (c, b) in bary.iter().enumerate() {
+                for (d, x) in domain.iter_mut().zip(b) {
+                    *d += w[c] * x;
+                }
+            }
+            samples.barys.push(domain);
+        }
+    }
+    samples.points.clear();
+    surface.evaluate_points(tri, &samples.barys, &mut samples.points);
+    for (t, on_surface) in samples.points.chunks_exact(WEIGHTS.len()).enumerate() {
+        let flat = [0, 1, 2].map(|c| corner(t, c));
+        let mut worst = 0.0f64;
+        for (w, s) in WEIGHTS.iter().zip(on_surface) {
+            let on_flat = w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2];
+            worst = worst.max(s.position.distance(on_flat));
+        }
+        each(t, worst);
+    }
 }
 
 /// The chord error of one source triangle cut by `pattern`, whose output triangle `t` has
@@ -78,33 +128,69 @@ pub(crate) fn pattern_error(
     tri: usize,
     pattern: &Pattern,
     corner: impl Fn(usize, usize) -> DVec3,
+    samples: &mut Samples,
 ) -> f64 {
     let mut worst = 0.0f64;
-    for (t, points) in pattern.triangles.iter().enumerate() {
-        let bary = points.map(|p| pattern.bary(p));
-        let flat = [0, 1, 2].map(|c| corner(t, c));
-        for w in WEIGHTS {
-            let mut domain = [0.0; 3];
-            for (c, b) in bary.iter().enumerate() {
-                for (d, x) in domain.iter_mut().zip(b) {
-                    *d += w[c] * x;
-                }
-            }
-            let on_surface = surface.evaluate(tri, domain).position;
-            let on_flat = w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2];
-            worst = worst.max(on_surface.distance(on_flat));
-        }
-    }
+    triangle_errors(surface, tri, pattern, corner, samples, |_, e| {
+        worst = worst.max(e);
+    });
     worst
 }
 
 /// The chord error of source triangle `tri` cut by `pattern`, its vertices evaluated on its
-/// own side (equal to the written ones up to rounding): measured without tessellating.
-pub(crate) fn predicted_error(surface: &dyn Surface, tri: usize, pattern: &Pattern) -> f64 {
-    let vertices: Vec<DVec3> = (0..pattern.lattice.len() as u32)
-        .map(|p| surface.evaluate(tri, pattern.bary(p)).position)
-        .collect();
-    pattern_error(surface, tri, pattern, |t, c| {
-        vertices[pattern.triangles[t][c] as usize]
-    })
+/// own side (equal to the written ones up to rounding), by part: measured without
+/// tessellating.
+pub(crate) fn measured_error(
+    surface: &dyn Surface,
+    tri: usize,
+    pattern: &Pattern,
+    samples: &mut Samples,
+) -> PatternError {
+    // The pattern's points in its numbering: corners, each edge's samples, the interior, each
+    // as the lattice parts list them.
+    samples.points.clear();
+    surface.evaluate_points(
+        tri,
+        &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        &mut samples.points,
+    );
+    for k in 0..3 {
+        let n = pattern.key.edges[k];
+        if n > 1 {
+            surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut samples.points);
+        }
+    }
+    if pattern.key.inner >= 3 {
+        surface.evaluate_lattice_part(
+            tri,
+            pattern.key.inner,
+            LatticePart::Interior,
+            &mut samples.points,
+        );
+    }
+    debug_assert_eq!(samples.points.len(), pattern.lattice.len());
+    let mut vertices = std::mem::take(&mut samples.vertices);
+    vertices.clear();
+    vertices.extend(samples.points.iter().map(|p| p.position));
+    let mut error = PatternError::default();
+    triangle_errors(
+        surface,
+        tri,
+        pattern,
+        |t, c| vertices[pattern.triangles[t][c] as usize],
+        samples,
+        |t, e| {
+            let touches = pattern.touches(t);
+            if touches == 0 {
+                error.inner = error.inner.max(e);
+            }
+            for (k, edge) in error.edges.iter_mut().enumerate() {
+                if touches & (1 << k) != 0 {
+                    *edge = edge.max(e);
+                }
+            }
+        },
+    );
+    samples.vertices = vertices;
+    error
 }

@@ -2,24 +2,26 @@
 //! within a chord error of the smooth surface, or within a triangle budget.
 //!
 //! The chord error of linear interpolation over a triangle with edge vectors `d_ab` is, for a
-//! surface that is locally quadratic, `S(λ) − L(λ) = ½ Σ_{a<b} λ_a λ_b d_abᵀ H d_ab`, at most
-//! `K/6` (at the centroid) where `K` is the largest second difference along an edge; along a
-//! single edge curve it is `K/8` (at the midpoint). Both fall as `1/n²` with the segment count.
-//! So one probe per triangle, the level-[`PROBE_LEVEL`] lattice and its second differences in
-//! the three lattice directions, gives each triangle and each edge an error constant `c` with
-//! error ≈ `c/n²`; the counts for any tolerance, and the tolerance that meets a budget, follow
-//! without evaluating the surface again.
-//!
+//! surface that is locally quadratic, `S(λ) − L(λ) = ½ Σ_{a<b} λ_a λ_b d_abᵀ H d_ab`
+//! (`estimate.rs` predicts it from a lattice's second differences); along a single edge curve
+//! it is `K/8` at the midpoint, `K` the second difference along the edge. Both fall as `1/n²`
+//! with the segment count. So one probe per triangle, the level-[`PROBE_LEVEL`] lattice and its
+//! second differences in the three lattice directions, gives each triangle and each edge an
+//! error constant `c` with error ≈ `c/n²`; the counts for any tolerance, and the tolerance that
+//! meets a budget, follow without evaluating the surface again. A tolerance is then checked on
+//! each triangle's lattice at its own resolution ([`ChordErrors::refine_to_tolerance`]).
+
 //! Two balance rules keep the transition patterns well shaped (`transition.rs`): a triangle's
 //! inner level is at least each of its edge counts, and each edge count is at least half the
 //! inner level of each triangle beside it. Raising one value raises its neighbours to half of
 //! it, so the propagation dies out within `log₂(cap)` steps: a few sweeps over the mesh.
 //!
-//! It deliberately builds no pattern and writes no vertex.
+//! It deliberately writes no vertex.
 
 use rayon::prelude::*;
 
-use super::chord::predicted_error;
+use super::chord::measured_error;
+use super::estimate::{Curvature, PatternError, PatternModel};
 use super::evaluator;
 use super::transition::{Pattern, PatternKey};
 use crate::mesh::TriMesh;
@@ -35,6 +37,18 @@ pub const PROBE_LEVEL: u32 = 6;
 /// on the icosphere, torus, bumpy sphere, height field and domed plate (`tests/integration/tessellate_adaptive.rs`),
 /// the error reached without it is up to 4% over the target.
 pub const MARGIN: f64 = 1.25;
+
+/// How far over the tolerance the lattice check lets a pattern be, leaving the last step to
+/// the measurement: on coarse low-poly assets (Suzanne, Fox) the lattice over-predicts near
+/// the corners, where a few lattice steps span all of a triangle's change of curvature, and
+/// counts it raised would stay raised.
+const ESTIMATE_SLACK: f64 = 1.5;
+
+/// The lattice level a pattern of inner level `inner` is checked on: its own, or the probe's
+/// when that is finer.
+fn check_level(inner: u32) -> u32 {
+    (2 * inner).max(PROBE_LEVEL)
+}
 
 /// The chord error constants of a mesh's surface: error ≈ `c / n²` at `n` segments.
 #[derive(Debug, Clone)]
@@ -61,15 +75,19 @@ impl ChordErrors {
         let scale = f64::from(p * p);
         let per_tri: Vec<(f64, [f64; 3])> = (0..mesh.triangles.len())
             .into_par_iter()
-            .map_init(Vec::new, |points: &mut Vec<SurfacePoint>, tri| {
-                points.clear();
-                surface.evaluate_lattice(tri, p, points);
-                let (inner, edges) = second_differences(points, p);
-                (
-                    finite(inner * scale / 6.0),
-                    edges.map(|d| finite(d * scale / 8.0)),
-                )
-            })
+            .map_init(
+                || (Vec::new(), Curvature::default()),
+                |(points, curvature): &mut (Vec<SurfacePoint>, Curvature), tri| {
+                    points.clear();
+                    surface.evaluate_lattice(tri, p, points);
+                    curvature.read(points, p);
+                    let edges = edge_second_differences(points, p);
+                    (
+                        finite(curvature.lattice_error(p) * scale),
+                        edges.map(|d| finite(d * scale / 8.0)),
+                    )
+                },
+            )
             .collect();
         let mut edges = vec![0.0f64; topo.edges.len()];
         for (e, c) in edges.iter_mut().enumerate() {
@@ -86,8 +104,18 @@ impl ChordErrors {
 
     /// The counts that keep the chord error at or below `tolerance`, each at most `cap`.
     pub fn counts(&self, topo: &Topology, tolerance: f64, cap: u32) -> SegmentCounts {
+        self.counts_with_margin(topo, tolerance, cap, MARGIN)
+    }
+
+    fn counts_with_margin(
+        &self,
+        topo: &Topology,
+        tolerance: f64,
+        cap: u32,
+        margin: f64,
+    ) -> SegmentCounts {
         let need = |c: f64| -> u32 {
-            let n = (MARGIN * c / tolerance).sqrt().ceil();
+            let n = (margin * c / tolerance).sqrt().ceil();
             if n.is_nan() || n < 1.0 {
                 1
             } else {
@@ -102,13 +130,18 @@ impl ChordErrors {
         counts
     }
 
-    /// The counts that keep the measured chord error at or below `tolerance`: the prediction
-    /// of [`ChordErrors::counts`], then, while some triangle's pattern measures over the
-    /// tolerance (the chord module's samples, on the surface, without tessellating), its
-    /// counts scaled up by `√(error/tolerance)` and rebalanced; only triangles whose counts
-    /// changed are measured again. The probe cannot see curvature narrower than its spacing
-    /// (the G² blend bands along edges, where the error first falls as `1/n`), which the
-    /// measurement does.
+    /// The counts that keep the measured chord error at or below `tolerance`: the prediction of
+    /// [`ChordErrors::counts`] without its margin, then two rounds of checks that raise the
+    /// counts of each failing part of a pattern (its inner lattice, or the edges its boundary
+    /// triangles touch) by `√(error/tolerance)` and rebalance, checking again only triangles
+    /// whose counts changed:
+    ///
+    /// 1. predicted from the lattice of the pattern's own resolution (`estimate.rs`: one lattice
+    ///    evaluation per triangle through the surface's cached weights), which brings the
+    ///    smooth parts to within 1.5× (`ESTIMATE_SLACK`) of the tolerance cheaply;
+    /// 2. measured at the chord module's sample points, which sees what no lattice does: the
+    ///    G² blend's narrow features (along edges, and strongest near irregular vertices, the
+    ///    error there barely falls from level 2 to 8).
     ///
     /// Stops when every triangle meets the tolerance or is at `cap`.
     pub fn refine_to_tolerance(
@@ -118,53 +151,28 @@ impl ChordErrors {
         tolerance: f64,
         cap: u32,
     ) -> SegmentCounts {
-        let mut counts = self.counts(topo, tolerance, cap);
-        let mut measured: Vec<Option<PatternKey>> = vec![None; counts.inner.len()];
-        loop {
-            let keys: Vec<PatternKey> = (0..counts.inner.len())
-                .map(|t| counts.key(topo, t))
-                .collect();
-            let mut distinct: Vec<PatternKey> = keys
-                .iter()
-                .zip(&measured)
-                .filter(|(k, m)| m.as_ref() != Some(k))
-                .map(|(k, _)| *k)
-                .collect();
-            distinct.sort_unstable();
-            distinct.dedup();
-            let patterns: Vec<Pattern> = distinct.par_iter().map(|&k| Pattern::new(k)).collect();
-            let over: Vec<(usize, f64)> = (0..keys.len())
-                .into_par_iter()
-                .filter(|&t| measured[t].as_ref() != Some(&keys[t]))
-                .filter_map(|t| {
-                    let pattern = &patterns[distinct.binary_search(&keys[t]).ok()?];
-                    let error = predicted_error(surface, t, pattern);
-                    (error > tolerance).then_some((t, error))
-                })
-                .collect();
-            measured.clone_from_slice(&keys.into_iter().map(Some).collect::<Vec<_>>());
-            // Each failing triangle scales its interior and edges from this round's counts; an
-            // edge between two failing triangles takes the larger, not both in turn.
-            let mut raised = false;
-            let edges_before = counts.edges.clone();
-            for (t, error) in over {
-                let factor = (error / tolerance).sqrt() * 1.05;
-                let scale = |c: u32| ((f64::from(c) * factor).ceil() as u32).max(c + 1).min(cap);
-                let inner = scale(counts.inner[t]);
-                raised |= inner > counts.inner[t];
-                counts.inner[t] = inner;
-                for e in topo.tri_edges[t] {
-                    let e = e.0 as usize;
-                    let next = scale(edges_before[e]);
-                    raised |= next > counts.edges[e];
-                    counts.edges[e] = counts.edges[e].max(next);
-                }
-            }
-            if !raised {
-                return counts;
-            }
-            counts.balance(topo);
-        }
+        let mut counts = self.counts_with_margin(topo, tolerance, cap, 1.0);
+        counts.raise_until_met(
+            topo,
+            tolerance * ESTIMATE_SLACK,
+            cap,
+            |key| PatternModel::new(&Pattern::new(key)),
+            |tri, model, (points, curvature): &mut (Vec<SurfacePoint>, Curvature)| {
+                let level = check_level(model.inner());
+                points.clear();
+                surface.evaluate_lattice(tri, level, points);
+                curvature.read(points, level);
+                model.error(curvature)
+            },
+        );
+        counts.raise_until_met(
+            topo,
+            tolerance,
+            cap,
+            Pattern::new,
+            |tri, pattern, samples| measured_error(surface, tri, pattern, samples),
+        );
+        counts
     }
 
     /// The largest tolerance (and its counts) whose output has at most `budget` triangles, by
@@ -210,45 +218,21 @@ fn finite(x: f64) -> f64 {
     }
 }
 
-/// Largest second difference of a level-`p` lattice of surface points in any of the three
-/// lattice directions, and along each of the triangle's three edges (edge `k` opposite corner
-/// `k`).
-fn second_differences(points: &[SurfacePoint], p: u32) -> (f64, [f64; 3]) {
+/// Largest second difference along each of the triangle's three edges (edge `k` opposite
+/// corner `k`) of a level-`p` lattice of surface points.
+fn edge_second_differences(points: &[SurfacePoint], p: u32) -> [f64; 3] {
     let at = |i: u32, j: u32| points[lattice_index(p, i, j)].position;
     let d2 = |a: (u32, u32), b: (u32, u32), c: (u32, u32)| {
         (at(a.0, a.1) - 2.0 * at(b.0, b.1) + at(c.0, c.1)).length()
     };
-    let mut inner = 0.0f64;
     let mut edges = [0.0f64; 3];
-    for j in 0..=p {
-        for i in 0..=p - j {
-            // Along i (j fixed): edge 2 when j = 0.
-            if i >= 1 && i < p - j {
-                let d = d2((i - 1, j), (i, j), (i + 1, j));
-                inner = inner.max(d);
-                if j == 0 {
-                    edges[2] = edges[2].max(d);
-                }
-            }
-            // Along j (i fixed): edge 1 when i = 0.
-            if j >= 1 && i + j < p {
-                let d = d2((i, j - 1), (i, j), (i, j + 1));
-                inner = inner.max(d);
-                if i == 0 {
-                    edges[1] = edges[1].max(d);
-                }
-            }
-            // Along i + j fixed: edge 0 when i + j = p.
-            if i >= 1 && j >= 1 {
-                let d = d2((i + 1, j - 1), (i, j), (i - 1, j + 1));
-                inner = inner.max(d);
-                if i + j == p {
-                    edges[0] = edges[0].max(d);
-                }
-            }
-        }
+    for m in 1..p {
+        // Edge 2: j = 0; edge 1: i = 0; edge 0: i + j = p.
+        edges[2] = edges[2].max(d2((m - 1, 0), (m, 0), (m + 1, 0)));
+        edges[1] = edges[1].max(d2((0, m - 1), (0, m), (0, m + 1)));
+        edges[0] = edges[0].max(d2((p - m + 1, m - 1), (p - m, m), (p - m - 1, m + 1)));
     }
-    (inner, edges)
+    edges
 }
 
 impl SegmentCounts {
@@ -284,6 +268,74 @@ impl SegmentCounts {
             .copied()
             .max()
             .unwrap_or(1)
+    }
+
+    /// Checks every triangle's pattern with `check` (on what `build` makes of its key, built
+    /// once per distinct key) and raises the counts of its failing parts until none fails or
+    /// they are at `cap`; after the first round only triangles whose counts changed are checked.
+    fn raise_until_met<P: Send + Sync, S: Default + Send>(
+        &mut self,
+        topo: &Topology,
+        tolerance: f64,
+        cap: u32,
+        build: impl Fn(PatternKey) -> P + Sync,
+        check: impl Fn(usize, &P, &mut S) -> PatternError + Sync,
+    ) {
+        let mut checked: Vec<Option<PatternKey>> = vec![None; self.inner.len()];
+        loop {
+            let keys: Vec<PatternKey> = (0..self.inner.len()).map(|t| self.key(topo, t)).collect();
+            let mut distinct: Vec<PatternKey> = keys
+                .iter()
+                .zip(&checked)
+                .filter(|(k, c)| c.as_ref() != Some(k))
+                .map(|(k, _)| *k)
+                .collect();
+            distinct.sort_unstable();
+            distinct.dedup();
+            let built: Vec<P> = distinct.par_iter().map(|&k| build(k)).collect();
+            let over: Vec<(usize, PatternError)> = (0..keys.len())
+                .into_par_iter()
+                .filter(|&t| checked[t].as_ref() != Some(&keys[t]))
+                .map_init(S::default, |scratch, t| {
+                    let p = &built[distinct.binary_search(&keys[t]).ok()?];
+                    let error = check(t, p, scratch);
+                    let fails =
+                        error.inner > tolerance || error.edges.iter().any(|&e| e > tolerance);
+                    fails.then_some((t, error))
+                })
+                .flatten()
+                .collect();
+            for (c, k) in checked.iter_mut().zip(keys) {
+                *c = Some(k);
+            }
+            // Each failing part scales its count from this round's counts; an edge between two
+            // failing triangles takes the larger, not both in turn.
+            let mut raised = false;
+            let edges_before = self.edges.clone();
+            let scale = |c: u32, error: f64| {
+                let n = (f64::from(c) * (error / tolerance).sqrt()).ceil() as u32;
+                n.max(c + 1).min(cap)
+            };
+            for (t, error) in over {
+                if error.inner > tolerance {
+                    let inner = scale(self.inner[t], error.inner);
+                    raised |= inner > self.inner[t];
+                    self.inner[t] = inner;
+                }
+                for (k, e) in topo.tri_edges[t].into_iter().enumerate() {
+                    if error.edges[k] > tolerance {
+                        let e = e.0 as usize;
+                        let next = scale(edges_before[e], error.edges[k]);
+                        raised |= next > self.edges[e];
+                        self.edges[e] = self.edges[e].max(next);
+                    }
+                }
+            }
+            if !raised {
+                return;
+            }
+            self.balance(topo);
+        }
     }
 
     /// Applies the two balance rules of the module docs until neither raises anything.

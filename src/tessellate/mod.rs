@@ -40,6 +40,7 @@ mod adaptive;
 mod blocks;
 mod chord;
 mod counts;
+mod estimate;
 mod lattice_edges;
 mod layout;
 mod plan;

@@ -125,6 +125,23 @@ impl Pattern {
         [(n - i - j) / n, i / n, j / n]
     }
 
+    /// The source triangle's edges output triangle `t` touches (bit `k` for edge `k`; a corner
+    /// touches both its edges): 0 for a triangle of the inner lattice.
+    pub fn touches(&self, t: usize) -> u8 {
+        let mut edges = 0u8;
+        for &p in &self.triangles[t] {
+            if p < 3 {
+                edges |= (1 << ((p + 1) % 3)) | (1 << ((p + 2) % 3));
+            } else if p < self.interior_start {
+                // The last edge whose samples start at or before p (empty edges start where
+                // the next one does).
+                let k = (0..3).rev().find(|&k| p >= self.edge_start[k]).unwrap_or(0);
+                edges |= 1 << k;
+            }
+        }
+        edges
+    }
+
     /// Point index of step `mstep` along edge `k` (walked from corner `k + 1`).
     fn edge(&self, k: usize, mstep: u32) -> u32 {
         if mstep == 0 {
