@@ -375,15 +375,18 @@ impl Surface for G2Surface {
     /// net composed once for all of them instead of once per point.
     fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
         let patch = &self.patches[tri];
-        let own = broadcast(&patch.net);
+        let widths = self.widths(patch);
+        let local = self.local(tri);
+        let own = broadcast(&local.net);
         let mut across: [Option<Broadcast<1>>; 3] = [None; 3];
         out.reserve(barys.len());
         for &bary in barys {
-            let w = PointWeights::at(bary, patch.h, self.profile);
+            let w = PointWeights::at(bary, widths, self.profile);
             if let Some(c) = w.corner {
+                let c = c as usize;
                 out.push(SurfacePoint {
-                    position: patch.position[c as usize],
-                    normal: patch.normal[c as usize],
+                    position: corner(&local.net, c),
+                    normal: local.normal[c],
                 });
                 continue;
             }
@@ -391,7 +394,7 @@ impl Surface for G2Surface {
                 let k = w.k as usize;
                 &*across[k].get_or_insert_with(|| broadcast(&self.across_net(patch, k)))
             });
-            let [p] = Self::combine(patch, &Lanes::<1>::single(&w), &own, net);
+            let [p] = Self::combine(&local.normal, &Lanes::<1>::single(&w), &own, net);
             out.push(p);
         }
     }
