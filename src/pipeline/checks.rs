@@ -12,7 +12,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::mesh::TriMesh;
-use crate::topology::{EdgeKind, Topology};
+use crate::topology::{EdgeId, EdgeKind, EdgeUse, Topology};
 
 /// Triangles whose smallest angle is below this (in radians, about 0.06°) are slivers: valid,
 /// but their normals and parameterization are numerically fragile.
@@ -27,28 +27,25 @@ const EXAMPLES: usize = 3;
 /// `index`), each naming the fallback applied.
 pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<String> {
     let mut out = Vec::new();
-    let degenerate: Vec<usize> = (0..topo.degenerate.len())
-        .filter(|&t| topo.degenerate[t])
-        .collect();
+    let degenerate = Tally::of(topo.degenerate.len(), |t| topo.degenerate[t]);
     say(
         &mut out,
         index,
-        degenerate.len(),
-        first(&degenerate),
+        degenerate.count,
+        degenerate.examples(),
         "zero-area triangles",
         "are kept flat; their edges are not blended",
     );
 
     let sliver_cos = SLIVER_ANGLE.cos();
-    let slivers: Vec<usize> = (0..mesh.triangles.len())
-        .into_par_iter()
-        .filter(|&t| !topo.degenerate[t] && largest_angle_cosine(mesh, t) > sliver_cos)
-        .collect();
+    let slivers = Tally::of(mesh.triangles.len(), |t| {
+        !topo.degenerate[t] && largest_angle_cosine(mesh, t) > sliver_cos
+    });
     say(
         &mut out,
         index,
-        slivers.len(),
-        first(&slivers),
+        slivers.count,
+        slivers.examples(),
         "sliver triangles",
         "(an angle below 0.06°) are smoothed like the others; their shading may be poor",
     );
@@ -57,8 +54,8 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Strin
     say(
         &mut out,
         index,
-        duplicates.len(),
-        first(&duplicates),
+        duplicates.count,
+        duplicates.examples(),
         "duplicate triangles",
         "(same corners as an earlier one) are kept; their shared edges are not blended",
     );
@@ -69,85 +66,126 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Strin
             used[c as usize] = true;
         }
     }
-    let unused: Vec<usize> = (0..used.len()).filter(|&v| !used[v]).collect();
+    let unused = Tally::of(used.len(), |v| !used[v]);
+    drop(used);
     say(
         &mut out,
         index,
-        unused.len(),
-        first(&unused),
+        unused.count,
+        unused.examples(),
         "vertices used by no triangle",
         "are not written",
     );
 
-    let facing_away: Vec<usize> = (0..mesh.triangles.len())
-        .into_par_iter()
-        .filter(|&t| {
-            let tri = mesh.triangles[t];
-            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
-            let face = (b - a).cross(c - a);
-            !topo.degenerate[t]
-                && tri
-                    .iter()
-                    .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
-        })
-        .collect();
+    let facing_away = Tally::of(mesh.triangles.len(), |t| {
+        let tri = mesh.triangles[t];
+        let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+        let face = (b - a).cross(c - a);
+        !topo.degenerate[t]
+            && tri
+                .iter()
+                .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
+    });
     say(
         &mut out,
         index,
-        facing_away.len(),
-        first(&facing_away),
+        facing_away.count,
+        facing_away.examples(),
         "triangles whose normals all face away from their winding",
         "follow their normals (the surface is oriented by the normals, not the winding)",
     );
 
-    let count = |kind: EdgeKind| topo.edges.iter().filter(|e| e.kind == kind).count();
-    let boundary = count(EdgeKind::Boundary);
+    let kind_of = |e: usize| topo.edge_kind(EdgeId(e as u32));
+    let boundary = Tally::of(topo.edge_count(), |e| kind_of(e) == EdgeKind::Boundary).count;
     if boundary > 0 {
         out.push(format!(
             "mesh {index}: {boundary} open boundary edges are not blended (the surface follows the input there)"
         ));
     }
-    let non_manifold: Vec<usize> = (0..topo.edges.len())
-        .filter(|&e| topo.edges[e].kind == EdgeKind::NonManifold)
-        .collect();
+    let non_manifold = Tally::of(topo.edge_count(), |e| kind_of(e) == EdgeKind::NonManifold);
     say(
         &mut out,
         index,
-        non_manifold.len(),
-        first(&non_manifold),
+        non_manifold.count,
+        non_manifold.examples(),
         "non-manifold edges (three or more triangles)",
         "are not blended",
     );
 
-    let flipped: Vec<usize> = (0..topo.edges.len())
-        .filter(|&e| topo.edges[e].kind == EdgeKind::Interior && same_direction(topo, e))
-        .collect();
+    let flipped = Tally::of(topo.edge_count(), |e| {
+        kind_of(e) == EdgeKind::Interior && same_direction(topo, e)
+    });
     say(
         &mut out,
         index,
-        flipped.len(),
-        first(&flipped),
+        flipped.count,
+        flipped.examples(),
         "edges between triangles of opposite winding",
         "are smoothed as usual (the surface is oriented by the normals, not the winding)",
     );
 
-    let bow_ties = bow_tie_vertices(topo);
+    // One union-find buffer serves both connectivity passes.
+    let mut parent = Vec::new();
+    let bow_ties = bow_tie_vertices(topo, &mut parent);
     say(
         &mut out,
         index,
-        bow_ties.len(),
-        first(&bow_ties),
+        bow_ties.count,
+        bow_ties.examples(),
         "bow-tie vertices (triangle fans that touch only at the vertex)",
         "are kept; each fan is smoothed on its own",
     );
 
-    let pieces = pieces(topo);
+    let pieces = pieces(topo, &mut parent);
     if pieces > MANY_PIECES {
         out.push(format!(
             "mesh {index}: {pieces} disconnected pieces; each is smoothed on its own (expected a welded mesh?)"
         ));
     }
     out
+}
+
+/// How many indices passed a test, and the first [`EXAMPLES`] of them, found without listing
+/// them all (a scan of a million bad triangles keeps three).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Tally {
+    count: usize,
+    first: [usize; EXAMPLES],
+}
+
+impl Tally {
+    /// The indices in `0..n` for which `hit` holds, tested in parallel; the examples are the
+    /// smallest whatever the thread count (parts are merged in index order).
+    fn of(n: usize, hit: impl Fn(usize) -> bool + Sync) -> Tally {
+        (0..n)
+            .into_par_iter()
+            .fold(Tally::default, |mut t, i| {
+                if hit(i) {
+                    t.add(i);
+                }
+                t
+            })
+            .reduce(Tally::default, |mut a, b| {
+                for &i in b.examples() {
+                    a.add(i);
+                }
+                a.count += b.count - b.examples().len();
+                a
+            })
+    }
+
+    /// Counts `i`, keeping it as an example if it is among the smallest seen; indices must come
+    /// in ascending order.
+    fn add(&mut self, i: usize) {
+        if self.count < EXAMPLES {
+            self.first[self.count] = i;
+        }
+        self.count += 1;
+    }
+
+    fn examples(&self) -> &[usize] {
+        &self.first[..self.count.min(EXAMPLES)]
+    }
 }
 
 /// Adds "mesh i: N things (first: a, b, c) fallback" when there are any.
@@ -168,10 +206,6 @@ fn say(
     }
 }
 
-fn first(v: &[usize]) -> &[usize] {
-    &v[..v.len().min(EXAMPLES)]
-}
-
 /// The cosine of the smallest angle of triangle `t`: comparing cosines instead of angles spares
 /// three arc cosines per triangle, and the order is the same (the cosine falls as the angle
 /// grows).
@@ -185,9 +219,10 @@ fn largest_angle_cosine(mesh: &TriMesh, t: usize) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
-/// Triangles with the same three welded corners as an earlier triangle (in any order), in index
-/// order. Sorting the corner triples groups the copies: no hash map over every triangle.
-fn duplicate_triangles(topo: &Topology) -> Vec<usize> {
+/// Triangles with the same three welded corners as an earlier triangle (in any order). Sorting
+/// the corner triples groups the copies: no hash map over every triangle, and near-linear
+/// however many copies one triangle has.
+fn duplicate_triangles(topo: &Topology) -> Tally {
     let mut keyed: Vec<([u32; 3], u32)> = topo
         .tri_verts
         .par_iter()
@@ -200,22 +235,28 @@ fn duplicate_triangles(topo: &Topology) -> Vec<usize> {
         .collect();
     // Entries are distinct (the triangle index differs), so the order is the one there is.
     keyed.par_sort_unstable();
-    let mut out: Vec<usize> = keyed
-        .windows(2)
-        .filter(|w| w[0].0 == w[1].0)
-        .map(|w| w[1].1 as usize)
-        .collect();
-    out.sort_unstable();
-    out
+    // Every entry after the first of its group is a copy; the smallest copies are the examples.
+    let mut found = Tally::default();
+    for w in keyed.windows(2).filter(|w| w[0].0 == w[1].0) {
+        let t = w[1].1 as usize;
+        let kept = found.count.min(EXAMPLES);
+        let at = found.first[..kept].partition_point(|&x| x < t);
+        if at < EXAMPLES {
+            found.first.copy_within(at..EXAMPLES - 1, at + 1);
+            found.first[at] = t;
+        }
+        found.count += 1;
+    }
+    found
 }
 
 /// Do both triangles of interior edge `e` run along it in the same direction (one of them is
 /// wound the other way)?
 fn same_direction(topo: &Topology, e: usize) -> bool {
-    let edge = &topo.edges[e];
-    let dir = |(t, k): (crate::topology::TriId, u8)| {
-        let v = topo.tri_verts[t.0 as usize];
-        v[(k as usize + 1) % 3] == edge.verts[0]
+    let edge = topo.edge(EdgeId(e as u32));
+    let dir = |u: EdgeUse| {
+        let (t, k) = u.at();
+        topo.tri_verts[t][(k + 1) % 3] == edge.verts[0]
     };
     dir(edge.tris[0]) == dir(edge.tris[1])
 }
@@ -223,90 +264,79 @@ fn same_direction(topo: &Topology, e: usize) -> bool {
 /// Welded vertices whose triangles form more than one fan (connected through edges that contain
 /// the vertex).
 ///
-/// One union-find over every (vertex, triangle) corner: each edge joins the corners of all its
-/// triangles at each of its end points, once. Walking edges rather than triangles keeps this
-/// linear in the corners whatever the valence (a book of 100 000 triangles on one edge, or
-/// 100 000 copies of one triangle), where joining per triangle and edge use was cubic in it.
-fn bow_tie_vertices(topo: &Topology) -> Vec<usize> {
-    // The triangles around each welded vertex, in triangle order, as one array cut by offsets
-    // (one allocation instead of one per vertex).
-    let n = topo.welded_positions.len();
-    let corners = |v: &[crate::topology::VertId; 3]| {
-        let [a, b, c] = v.map(|x| x.0 as usize);
-        [
-            Some(a),
-            (b != a).then_some(b),
-            (c != a && c != b).then_some(c),
-        ]
+/// One union-find over the triangle corners (`3 × triangle + corner`, a triangle with two
+/// welded corners at one vertex counting once, by its first): every edge joins the corners of
+/// all its triangles at each of its end points, straight from its uses. Walking edges rather than
+/// triangles keeps this linear in the corners whatever the valence (a book of 100 000 triangles
+/// on one edge, or 100 000 copies of one triangle), where joining per triangle and edge use was
+/// cubic in it. A vertex is a bow-tie when its corners fall into two or more classes.
+fn bow_tie_vertices(topo: &Topology, parent: &mut Vec<u32>) -> Tally {
+    // The corner of `t` holding the welded vertex of its corner `c`: the first with it.
+    let canonical = |t: usize, c: usize| {
+        let v = topo.tri_verts[t];
+        let first = v.iter().position(|&x| x == v[c]).unwrap_or(c);
+        (3 * t + first) as u32
     };
-    let mut start = vec![0usize; n + 1];
-    for v in &topo.tri_verts {
-        for x in corners(v).into_iter().flatten() {
-            start[x + 1] += 1;
-        }
-    }
-    for i in 0..n {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start.clone();
-    let mut around = vec![0u32; start[n]];
-    for (t, v) in topo.tri_verts.iter().enumerate() {
-        for x in corners(v).into_iter().flatten() {
-            around[fill[x]] = t as u32;
-            fill[x] += 1;
-        }
-    }
-    // The slot of triangle `t` in vertex `x`'s run of `around` (sorted by triangle).
-    let slot = |x: usize, t: u32| {
-        let run = &around[start[x]..start[x + 1]];
-        start[x] + run.binary_search(&t).expect("the triangle uses the vertex")
-    };
-    let mut parent: Vec<usize> = (0..around.len()).collect();
-    for e in &topo.edges {
-        let [a, b] = e.verts.map(|v| v.0 as usize);
-        let ends: &[usize] = if a == b { &[a] } else { &[a, b] };
-        let Some(&(first, _)) = e.tris.first() else {
+    parent.clear();
+    parent.extend(0..3 * topo.tri_verts.len() as u32);
+    for e in 0..topo.edge_count() {
+        let uses = topo.edge_uses(EdgeId(e as u32));
+        let Some((&head, rest)) = uses.split_first() else {
             continue;
         };
-        for &x in ends {
-            let s0 = slot(x, first.0);
-            for &(t, _) in &e.tris[1..] {
-                let (r0, r1) = (root(&mut parent, s0), root(&mut parent, slot(x, t.0)));
-                parent[r1] = r0;
+        let (t0, k0) = head.at();
+        for end in [1, 2] {
+            let anchor = canonical(t0, (k0 + end) % 3);
+            for u in rest {
+                let (t, k) = u.at();
+                // The use's corner at the same welded vertex as the anchor.
+                let c = if topo.tri_verts[t][(k + end) % 3] == topo.tri_verts[t0][(k0 + end) % 3] {
+                    (k + end) % 3
+                } else {
+                    (k + 3 - end) % 3
+                };
+                union(parent, anchor, canonical(t, c));
             }
         }
     }
-    (0..n)
-        .filter(|&v| {
-            (start[v]..start[v + 1])
-                .filter(|&s| root(&mut parent, s) == s)
-                .nth(1)
-                .is_some()
-        })
-        .collect()
+    // Classes per welded vertex: its canonical corners that are roots (saturating at 2).
+    let mut classes = vec![0u8; topo.welded_positions.len()];
+    for t in 0..topo.tri_verts.len() {
+        for c in 0..3 {
+            let corner = (3 * t + c) as u32;
+            if canonical(t, c) == corner && root(parent, corner) == corner {
+                let n = &mut classes[topo.tri_verts[t][c].0 as usize];
+                *n = n.saturating_add(1);
+            }
+        }
+    }
+    Tally::of(classes.len(), |v| classes[v] > 1)
 }
 
 /// Connected pieces of triangles (through welded edges).
-fn pieces(topo: &Topology) -> usize {
-    let n = topo.tri_verts.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    for e in &topo.edges {
-        for w in e.tris.windows(2) {
-            let (a, b) = (
-                root(&mut parent, w[0].0 .0 as usize),
-                root(&mut parent, w[1].0 .0 as usize),
-            );
-            parent[a] = b;
+fn pieces(topo: &Topology, parent: &mut Vec<u32>) -> usize {
+    let n = topo.tri_verts.len() as u32;
+    parent.clear();
+    parent.extend(0..n);
+    for e in 0..topo.edge_count() {
+        for w in topo.edge_uses(EdgeId(e as u32)).windows(2) {
+            union(parent, w[0].tri().0, w[1].tri().0);
         }
     }
-    (0..n).filter(|&i| root(&mut parent, i) == i).count()
+    (0..n).filter(|&i| root(parent, i) == i).count()
+}
+
+/// Joins the classes of `a` and `b`, the larger root under the smaller.
+fn union(p: &mut [u32], a: u32, b: u32) {
+    let (a, b) = (root(p, a), root(p, b));
+    p[a.max(b) as usize] = a.min(b);
 }
 
 /// The root of `i` in the union-find forest `p`, halving the path on the way.
-fn root(p: &mut [usize], mut i: usize) -> usize {
-    while p[i] != i {
-        p[i] = p[p[i]];
-        i = p[i];
+fn root(p: &mut [u32], mut i: u32) -> u32 {
+    while p[i as usize] != i {
+        p[i as usize] = p[p[i as usize] as usize];
+        i = p[i as usize];
     }
     i
 }
