@@ -7,7 +7,7 @@ use g2tess::continuity::angle_deg;
 use g2tess::mesh::TriMesh;
 use g2tess::surface::blend::map_point;
 use g2tess::surface::{lattice_bary, Surface};
-use g2tess::topology::{EdgeKind, Topology};
+use g2tess::topology::{EdgeKind, Topology, TriId};
 use glam::DVec3;
 
 /// An exact surface that a test mesh samples.

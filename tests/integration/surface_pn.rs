@@ -147,8 +147,8 @@ fn reordering_corners_or_flipping_triangles_does_not_move_the_surface() {
                     .abs()
                     * H_MAX
             };
-            let h1: Vec<f64> = topo.edges().map(|e| h_of(&topo, e)).collect();
-            let h2: Vec<f64> = topo2.edges().map(|e| h_of(&topo2, e)).collect();
+            let h1: Vec<f64> = topo.edges().map(|e| h_of(&topo, &e)).collect();
+            let h2: Vec<f64> = topo2.edges().map(|e| h_of(&topo2, &e)).collect();
             for profile in [Profile::Paper, Profile::C2] {
                 let s1 = G2Surface::new(&mesh, &topo, &h1, profile);
                 let s2 = G2Surface::new(&re.mesh, &topo2, &h2, profile);
