@@ -340,3 +340,115 @@ fn root(p: &mut [u32], mut i: u32) -> u32 {
     }
     i
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::topology::VertId;
+
+    /// Books, fans, bow-ties, copies in every corner order and collapsed triangles on a few
+    /// positions.
+    fn odd_mesh(seed: u64, tris: usize) -> TriMesh {
+        let mut state = seed;
+        let mut next = move |n: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % n
+        };
+        let positions: Vec<DVec3> = (0..30)
+            .map(|_| DVec3::new(next(4) as f64, next(4) as f64, next(3) as f64))
+            .collect();
+        let mut triangles = Vec::new();
+        while triangles.len() < tris {
+            let t = [next(30), next(30), next(30)].map(|v| v as u32);
+            triangles.push(t);
+            if next(4) == 0 {
+                triangles.push([t[2], t[0], t[1]]);
+            }
+        }
+        TriMesh {
+            normals: vec![DVec3::Z; positions.len()],
+            positions,
+            triangles,
+        }
+    }
+
+    /// Bow-tie vertices the slow way: per vertex, its distinct triangles joined when they
+    /// share an edge through it, components counted by search.
+    fn bow_ties_by_search(topo: &Topology) -> Vec<usize> {
+        let n = topo.welded_positions.len();
+        (0..n)
+            .filter(|&x| {
+                let x = VertId(x as u32);
+                let around: Vec<usize> = (0..topo.tri_verts.len())
+                    .filter(|&t| topo.tri_verts[t].contains(&x))
+                    .collect();
+                let shares_edge = |a: usize, b: usize| {
+                    let [va, vb] = [topo.tri_verts[a], topo.tri_verts[b]];
+                    // An edge through x: x with another corner of a that b also has, or x
+                    // twice in a triangle (a degenerate edge from x to x) that b shares.
+                    va.iter().any(|&y| y != x && vb.contains(&y))
+                        || (va.iter().filter(|&&y| y == x).count() > 1
+                            && vb.iter().filter(|&&y| y == x).count() > 1)
+                };
+                let mut seen = vec![false; around.len()];
+                let mut pieces = 0;
+                for s in 0..around.len() {
+                    if seen[s] {
+                        continue;
+                    }
+                    pieces += 1;
+                    let mut stack = vec![s];
+                    seen[s] = true;
+                    while let Some(i) = stack.pop() {
+                        for j in 0..around.len() {
+                            if !seen[j] && shares_edge(around[i], around[j]) {
+                                seen[j] = true;
+                                stack.push(j);
+                            }
+                        }
+                    }
+                }
+                pieces > 1
+            })
+            .collect()
+    }
+
+    #[test]
+    fn bow_ties_and_duplicates_match_the_slow_definitions_on_odd_shapes() {
+        for seed in 0..30 {
+            let mesh = odd_mesh(seed, 8 + 5 * seed as usize);
+            let topo = Topology::build(&mesh);
+            let want = bow_ties_by_search(&topo);
+            let got = bow_tie_vertices(&topo, &mut Vec::new());
+            assert_eq!(got.count, want.len(), "seed {seed}");
+            assert_eq!(got.examples(), &want[..want.len().min(EXAMPLES)]);
+
+            let key = |t: usize| {
+                let mut k = topo.tri_verts[t];
+                k.sort_unstable();
+                k
+            };
+            let copies: Vec<usize> = (0..mesh.triangles.len())
+                .filter(|&t| {
+                    let k = key(t);
+                    k[0] != k[1] && k[1] != k[2] && (0..t).any(|s| key(s) == k)
+                })
+                .collect();
+            let got = duplicate_triangles(&topo);
+            assert_eq!(got.count, copies.len(), "seed {seed}");
+            assert_eq!(got.examples(), &copies[..copies.len().min(EXAMPLES)]);
+        }
+    }
+
+    #[test]
+    fn a_tally_keeps_the_smallest_examples_whatever_the_split() {
+        let hits = |i: usize| i % 7 == 3 || i > 99_990;
+        let t = Tally::of(100_000, hits);
+        assert_eq!(t.count, (0..100_000).filter(|&i| hits(i)).count());
+        assert_eq!(t.examples(), &[3, 10, 17]);
+        assert_eq!(Tally::of(10, |i| i == 9).examples(), &[9]);
+        assert_eq!(Tally::of(0, |_| true), Tally::default());
+    }
+}
