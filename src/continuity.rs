@@ -99,7 +99,9 @@ pub fn measure(surface: &dyn Surface, topo: &Topology, sampling: &Sampling) -> C
     for edge in topo.edges().filter(|e| e.kind == EdgeKind::Interior) {
         edges += 1;
         let (f, k) = edge.tris[0].at();
-        let n = topo.neighbour(TriId(f as u32), k).expect("interior edges have a neighbour");
+        let n = topo
+            .neighbour(TriId(f as u32), k)
+            .expect("interior edges have a neighbour");
         let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));
         let (i, j) = ((k + 1) % 3, (k + 2) % 3);
         // Unit cross-edge direction into f (domain metric: |e_k − (e_i + e_j)/2| = √(3/2)).

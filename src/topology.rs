@@ -103,7 +103,7 @@ pub struct Neighbour {
 type PackedNeighbour = u32;
 const NO_NEIGHBOUR: PackedNeighbour = u32::MAX;
 
-/// The most triangles one [`Topology`] holds: [`PackedNeighbour`] spends `6 × triangles` of a
+/// The most triangles one [`Topology`] holds: a packed neighbour spends `6 × triangles` of a
 /// `u32` (over 700 million triangles, beyond what fits the memory of any machine this runs on).
 pub const MAX_TRIANGLES: usize = (u32::MAX / 6) as usize;
 
@@ -539,10 +539,16 @@ mod tests {
 
     #[test]
     fn edge_uses_pack_triangle_and_corner_in_order() {
-        let all: Vec<EdgeUse> = [(0, 2), (1, 0), (1, 1), (7, 2), (MAX_TRIANGLES as u32 - 1, 2)]
-            .iter()
-            .map(|&(t, k)| EdgeUse::new(TriId(t), k))
-            .collect();
+        let all: Vec<EdgeUse> = [
+            (0, 2),
+            (1, 0),
+            (1, 1),
+            (7, 2),
+            (MAX_TRIANGLES as u32 - 1, 2),
+        ]
+        .iter()
+        .map(|&(t, k)| EdgeUse::new(TriId(t), k))
+        .collect();
         assert!(all.windows(2).all(|w| w[0] < w[1]));
         assert_eq!(all[3].tri(), TriId(7));
         assert_eq!(all[3].corner(), 2);
@@ -623,9 +629,12 @@ mod tests {
         assert_eq!(w, vec![Warning::DegenerateTriangle { tri: TriId(3) }]);
     }
 
+    /// Each edge's end points and uses, one vector per edge.
+    type EdgeList = Vec<([VertId; 2], Vec<EdgeUse>)>;
+
     /// The adjacency rebuilt the obvious way (ordered maps, one vector per edge), to check the
     /// flat arrays against.
-    fn reference(mesh: &TriMesh) -> (Vec<VertId>, Vec<([VertId; 2], Vec<EdgeUse>)>) {
+    fn reference(mesh: &TriMesh) -> (Vec<VertId>, EdgeList) {
         let mut ids = std::collections::BTreeMap::new();
         let welded: Vec<VertId> = mesh
             .positions
@@ -701,12 +710,15 @@ mod tests {
             for (e, (verts, uses)) in edges.iter().enumerate() {
                 let edge = topo.edge(EdgeId(e as u32));
                 assert_eq!((edge.verts, edge.tris), (*verts, uses.as_slice()));
-                assert_eq!(topo.edge_between(verts[1], verts[0]), Some(EdgeId(e as u32)));
+                assert_eq!(
+                    topo.edge_between(verts[1], verts[0]),
+                    Some(EdgeId(e as u32))
+                );
                 for u in uses {
                     assert_eq!(topo.tri_edges[u.at().0][u.at().1], EdgeId(e as u32));
                 }
-                let degenerate = verts[0] == verts[1]
-                    || uses.iter().any(|u| topo.degenerate[u.at().0]);
+                let degenerate =
+                    verts[0] == verts[1] || uses.iter().any(|u| topo.degenerate[u.at().0]);
                 let kind = match uses.len() {
                     _ if degenerate => EdgeKind::Degenerate,
                     1 => EdgeKind::Boundary,
@@ -757,5 +769,38 @@ mod tests {
         let topo = Topology::build(&TriMesh::default());
         assert_eq!((topo.edge_count(), topo.edges().count()), (0, 0));
         assert!(topo.warnings().is_empty());
+    }
+
+    #[test]
+    fn every_array_is_sized_exactly_84_bytes_a_triangle_on_a_closed_mesh() {
+        // A torus of m × n quads: V = mn vertices, T = 2mn triangles, E = 3mn edges.
+        let (m, n) = (40u32, 25u32);
+        let at = |i: u32, j: u32| (i % m) * n + (j % n);
+        let mut mesh = TriMesh::default();
+        for i in 0..m {
+            for j in 0..n {
+                let (u, v) = (
+                    f64::from(i) * std::f64::consts::TAU / f64::from(m),
+                    f64::from(j) * std::f64::consts::TAU / f64::from(n),
+                );
+                let r = 2.0 + v.cos();
+                mesh.positions
+                    .push(DVec3::new(r * u.cos(), r * u.sin(), v.sin()));
+                mesh.triangles
+                    .push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                mesh.triangles
+                    .push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        mesh.normals = vec![DVec3::Z; mesh.positions.len()];
+        let topo = Topology::build(&mesh);
+        let (v, t, e) = ((m * n) as usize, (2 * m * n) as usize, (3 * m * n) as usize);
+        assert_eq!(topo.edge_count(), e);
+        assert!(topo.edges().all(|e| e.kind == EdgeKind::Interior));
+        // Per vertex: its welded id and position (4 + 24); per triangle: corners, edges,
+        // neighbours, uses (12 each) and the degenerate flag; per edge: end points, kind, split
+        // flag and use offset (8 + 1 + 1 + 4), plus the closing offset.
+        assert_eq!(topo.heap_bytes(), 28 * v + 49 * t + 14 * e + 4);
+        assert_eq!(topo.heap_bytes() / t, 84);
     }
 }

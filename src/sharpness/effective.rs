@@ -26,7 +26,11 @@ pub enum InvalidH {
     /// A width that is not finite or outside `[0, H_MAX]`.
     OutOfRange { edge: EdgeId, h: f64 },
     /// A width above 0 on an edge the surface never blends.
-    Unblended { edge: EdgeId, kind: EdgeKind, h: f64 },
+    Unblended {
+        edge: EdgeId,
+        kind: EdgeKind,
+        h: f64,
+    },
 }
 
 impl fmt::Display for InvalidH {
@@ -39,7 +43,11 @@ impl fmt::Display for InvalidH {
                 write!(f, "edge {}: h = {h} is outside [0, {H_MAX}]", edge.0)
             }
             InvalidH::Unblended { edge, kind, h } => {
-                write!(f, "edge {}: h = {h} on a {kind:?} edge, which is never blended", edge.0)
+                write!(
+                    f,
+                    "edge {}: h = {h} on a {kind:?} edge, which is never blended",
+                    edge.0
+                )
             }
         }
     }
@@ -175,10 +183,19 @@ mod tests {
         let asked = vec![0.2; topo.edge_count()];
         let (h, warnings) = EffectiveH::from_requested(&topo, &asked);
         for (e, edge) in topo.edges().enumerate() {
-            let want = if edge.kind == EdgeKind::Interior { 0.2 } else { 0.0 };
+            let want = if edge.kind == EdgeKind::Interior {
+                0.2
+            } else {
+                0.0
+            };
             assert_eq!(h[e], want, "edge {e} ({:?})", edge.kind);
         }
-        assert_eq!(topo.edges().filter(|e| e.kind == EdgeKind::Interior).count(), 6);
+        assert_eq!(
+            topo.edges()
+                .filter(|e| e.kind == EdgeKind::Interior)
+                .count(),
+            6
+        );
         let kinds: Vec<(EdgeKind, usize)> = warnings
             .iter()
             .map(|w| match w {
@@ -222,9 +239,18 @@ mod tests {
     fn checked_construction_rejects_what_the_rule_would_change() {
         let topo = mixed();
         let n = topo.edge_count();
-        let interior = topo.edges().position(|e| e.kind == EdgeKind::Interior).unwrap();
-        let boundary = topo.edges().position(|e| e.kind == EdgeKind::Boundary).unwrap();
-        let degenerate = topo.edges().position(|e| e.kind == EdgeKind::Degenerate).unwrap();
+        let interior = topo
+            .edges()
+            .position(|e| e.kind == EdgeKind::Interior)
+            .unwrap();
+        let boundary = topo
+            .edges()
+            .position(|e| e.kind == EdgeKind::Boundary)
+            .unwrap();
+        let degenerate = topo
+            .edges()
+            .position(|e| e.kind == EdgeKind::Degenerate)
+            .unwrap();
         let with = |e: usize, h: f64| {
             let mut v = vec![0.0; n];
             v[e] = h;
@@ -232,19 +258,31 @@ mod tests {
         };
         assert!(with(interior, H_MAX).is_ok());
         for bad in [f64::NAN, -1e-9, H_MAX * (1.0 + f64::EPSILON), f64::INFINITY] {
-            assert!(matches!(with(interior, bad), Err(InvalidH::OutOfRange { .. })), "{bad}");
+            assert!(
+                matches!(with(interior, bad), Err(InvalidH::OutOfRange { .. })),
+                "{bad}"
+            );
         }
         assert!(matches!(
             with(boundary, 0.1),
-            Err(InvalidH::Unblended { kind: EdgeKind::Boundary, .. })
+            Err(InvalidH::Unblended {
+                kind: EdgeKind::Boundary,
+                ..
+            })
         ));
         assert!(matches!(
             with(degenerate, 0.1),
-            Err(InvalidH::Unblended { kind: EdgeKind::Degenerate, .. })
+            Err(InvalidH::Unblended {
+                kind: EdgeKind::Degenerate,
+                ..
+            })
         ));
         assert_eq!(
             EffectiveH::new(&topo, vec![0.0; n + 1]),
-            Err(InvalidH::Count { widths: n + 1, edges: n })
+            Err(InvalidH::Count {
+                widths: n + 1,
+                edges: n
+            })
         );
         assert!(EffectiveH::zero(&topo).iter().all(|&h| h == 0.0));
     }

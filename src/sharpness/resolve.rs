@@ -126,11 +126,11 @@ pub(crate) fn resolve(
                 (0.0, HSource::HardEdge)
             } else if let Some(x) = section.and_then(|b| b.h.as_ref()) {
                 (x.value, HSource::SidecarMeshDefault(x.at.clone()))
-            } else if let Some((x, on_prim)) = sharpest(
-                sides().filter(|&p| side_h(p).is_some()),
-                |p| side_h(p).map_or(f64::INFINITY, |x| x.0.value),
-            )
-            .and_then(side_h)
+            } else if let Some((x, on_prim)) =
+                sharpest(sides().filter(|&p| side_h(p).is_some()), |p| {
+                    side_h(p).map_or(f64::INFINITY, |x| x.0.value)
+                })
+                .and_then(side_h)
             {
                 let at = x.at.clone();
                 let source = if on_prim {

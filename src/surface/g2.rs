@@ -116,7 +116,9 @@ impl G2Surface {
                 let h = topo.tri_edges[t].map(|e| h_edge[e.0 as usize]);
                 let across = std::array::from_fn(|k| {
                     (h[k] > 0.0).then(|| {
-                        let n = topo.neighbour(TriId(t as u32), k).expect("blended edges are interior");
+                        let n = topo
+                            .neighbour(TriId(t as u32), k)
+                            .expect("blended edges are interior");
                         Across {
                             tri: n.tri.0,
                             slots: n.slots,

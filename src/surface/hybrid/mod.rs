@@ -146,7 +146,9 @@ struct EdgeFrame {
 impl EdgeFrame {
     fn new(corners: &[Corners], topo: &Topology, e: usize) -> EdgeFrame {
         let (f, kf) = topo.edge_uses(EdgeId(e as u32))[0].at();
-        let n = topo.neighbour(TriId(f as u32), kf).expect("smooth edges are interior");
+        let n = topo
+            .neighbour(TriId(f as u32), kf)
+            .expect("smooth edges are interior");
         let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));
         let (i, j) = ((kf + 1) % 3, (kf + 2) % 3);
         let na = edge_end_normal(corners, f, i, g, slots[0]);

@@ -8,9 +8,9 @@ use glam::DVec3;
 
 use super::Warning;
 use crate::mesh::TriMesh;
+use crate::sharpness::EffectiveH;
 use crate::surface::pn::{central_point, pn_net, Net, B111, NEAR};
 use crate::surface::SurfacePoint;
-use crate::sharpness::EffectiveH;
 use crate::topology::Topology;
 
 /// Input corner positions and normalized input normals of one triangle (a zero normal falls back
