@@ -164,17 +164,26 @@ pub fn smooth_mesh(
     } = resolve(input, sharpness, options, asset, &mut report.warnings)?;
     report.times.sharpness = lap(&clock, 0.0);
     stop_if_cancelled(options, asset)?;
+    // Only the effective widths are read from here on: the requested h and where each came
+    // from (for `--explain-h`) are freed before the surface, the run's peak, is built.
+    let EdgeParams {
+        effective,
+        h,
+        sources,
+        ..
+    } = params;
+    drop((h, sources));
 
-    let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &params.effective);
+    let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &effective);
     report.warnings.extend(
         surface_warnings
             .into_iter()
             .map(|w| format!("mesh {}: {w}", input.mesh)),
     );
     report.edges = if options.report_figures {
-        EdgeFigures::measure(surface.as_ref(), &topo, &params.effective)
+        EdgeFigures::measure(surface.as_ref(), &topo, &effective)
     } else {
-        EdgeFigures::count(&topo, &params.effective)
+        EdgeFigures::count(&topo, &effective)
     };
     report.times.surface = lap(&clock, report.times.sharpness);
     stop_if_cancelled(options, asset)?;
@@ -191,7 +200,7 @@ pub fn smooth_mesh(
             ),
         ));
     }
-    let mut dense = density.tessellate(&mesh, &topo, &params.effective, surface.as_ref(), &groups);
+    let mut dense = density.tessellate(&mesh, &topo, &effective, surface.as_ref(), &groups);
     report.times.tessellate = tess_start.elapsed().as_secs_f64();
     report.adaptive = density.figures(
         &topo,
@@ -218,14 +227,7 @@ pub fn smooth_mesh(
     let attr_start = Instant::now();
     let mut primitives = Vec::with_capacity(prepared.len());
     let targets = morph::targets(
-        &mesh,
-        &topo,
-        &params.effective,
-        &prepared,
-        &groups,
-        &density,
-        options,
-        &remaps,
+        &mesh, &topo, &effective, &prepared, &groups, &density, options, &remaps,
     );
     for (k, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
         report.primitives.push(PrimitiveReport {
