@@ -14,7 +14,7 @@ use glam::DVec3;
 
 use crate::surface::blend::map_point;
 use crate::surface::Surface;
-use crate::topology::{EdgeKind, Topology};
+use crate::topology::{EdgeKind, Topology, TriId};
 
 /// Largest and 95th-percentile value of a set of samples (0 for no samples).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -96,10 +96,12 @@ pub fn measure(surface: &dyn Surface, topo: &Topology, sampling: &Sampling) -> C
     let (mut gaps, mut angles) = (Vec::new(), Vec::new());
     let mut curv: Vec<Vec<f64>> = vec![Vec::new(); sampling.eps.len()];
     let mut edges = 0;
-    for edge in topo.edges.iter().filter(|e| e.kind == EdgeKind::Interior) {
+    for edge in topo.edges().filter(|e| e.kind == EdgeKind::Interior) {
         edges += 1;
-        let (f, k) = (edge.tris[0].0 .0 as usize, edge.tris[0].1 as usize);
-        let n = topo.neighbours[f][k].expect("interior edges have a neighbour");
+        let (f, k) = edge.tris[0].at();
+        let n = topo
+            .neighbour(TriId(f as u32), k)
+            .expect("interior edges have a neighbour");
         let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));
         let (i, j) = ((k + 1) % 3, (k + 2) % 3);
         // Unit cross-edge direction into f (domain metric: |e_k − (e_i + e_j)/2| = √(3/2)).
@@ -178,8 +180,7 @@ pub fn angle_deg(a: DVec3, b: DVec3) -> f64 {
 /// Mean length of the welded edges with two distinct end points.
 pub fn mean_edge_length(topo: &Topology) -> f64 {
     let lengths: Vec<f64> = topo
-        .edges
-        .iter()
+        .edges()
         .filter(|e| e.verts[0] != e.verts[1])
         .map(|e| {
             let [a, b] = e.verts.map(|v| topo.welded_positions[v.0 as usize]);

@@ -11,7 +11,8 @@
 //!   finds boundary, non-manifold, degenerate and split-normal edges and each triangle edge's
 //!   neighbour.
 //! - [`sharpness`]: resolves one blend width `h` per welded edge from glTF extras, sidecar TOML,
-//!   the crease-angle rule and the defaults.
+//!   the crease-angle rule and the defaults, and decides once the width each edge is built with
+//!   ([`sharpness::EffectiveH`]: 0 on every edge the surface cannot blend).
 //! - [`normals`]: vertex normals for meshes that come without them.
 //! - [`surface`]: the smooth surfaces over a whole mesh behind the [`surface::Surface`] trait
 //!   ([`surface::PnSurface`], [`surface::G2Surface`] (the G² blend of Lee–Hwang–Yoon), and the

@@ -7,9 +7,9 @@
 //! Conventions: corner `k` of a triangle is opposite its edge `k`; edge `k` runs from corner
 //! `(k + 1) % 3` (called `i`) to corner `(k + 2) % 3` (called `j`).
 
-use rayon::slice::ParallelSliceMut as _;
-use std::collections::HashMap;
 use std::fmt;
+
+use rayon::prelude::*;
 
 use glam::DVec3;
 
@@ -40,97 +40,48 @@ pub enum EdgeKind {
     Degenerate,
 }
 
-/// One welded edge.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Edge {
+/// One use of a welded edge: a triangle and its local corner opposite the edge, packed as
+/// `3 × triangle + corner` in one `u32`, so that the uses of every edge fit one flat array and
+/// sort in (triangle, corner) order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct EdgeUse(u32);
+
+impl EdgeUse {
+    /// The use of edge `corner` (the edge opposite that corner) of triangle `tri`.
+    pub const fn new(tri: TriId, corner: u8) -> Self {
+        EdgeUse(tri.0 * 3 + corner as u32)
+    }
+
+    /// The triangle.
+    pub const fn tri(self) -> TriId {
+        TriId(self.0 / 3)
+    }
+
+    /// The triangle's local corner opposite the edge (0, 1 or 2).
+    pub const fn corner(self) -> u8 {
+        (self.0 % 3) as u8
+    }
+
+    /// `(triangle, corner)` as indices.
+    pub const fn at(self) -> (usize, usize) {
+        ((self.0 / 3) as usize, (self.0 % 3) as usize)
+    }
+}
+
+/// One welded edge, read from [`Topology`]'s arrays: a small copy, not stored anywhere.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Edge<'a> {
     /// End points, smaller id first.
     pub verts: [VertId; 2],
     /// Classification; non-interior edges act as h = 0.
     pub kind: EdgeKind,
-    /// Every use of the edge: the triangle and its local corner opposite the edge, in
-    /// (triangle, corner) order, so the first use is the lowest-numbered triangle.
-    pub tris: EdgeUses,
+    /// Every use of the edge in (triangle, corner) order, so the first use is the
+    /// lowest-numbered triangle.
+    pub tris: &'a [EdgeUse],
     /// The triangles using the edge carry different input normals at one of its end points
     /// (exact comparison: a hard edge, or a UV seam with slightly different normals).
     pub split_normals: bool,
 }
-
-/// The uses of one welded edge, `(triangle, local corner opposite the edge)`, read as a slice.
-///
-/// Up to two are held inline, as nearly every edge has one or two; more (a non-manifold edge)
-/// go to the heap. With a vector per edge, the allocations were a third of the time spent
-/// building the adjacency of a 100k-triangle mesh.
-#[derive(Debug, Clone)]
-pub struct EdgeUses(UsesRepr);
-
-#[derive(Debug, Clone)]
-enum UsesRepr {
-    Inline { len: u8, uses: [(TriId, u8); 2] },
-    Heap(Vec<(TriId, u8)>),
-}
-
-impl EdgeUses {
-    /// No uses yet.
-    pub const fn new() -> Self {
-        EdgeUses(UsesRepr::Inline {
-            len: 0,
-            uses: [(TriId(0), 0); 2],
-        })
-    }
-
-    /// Adds a use.
-    pub fn push(&mut self, item: (TriId, u8)) {
-        match &mut self.0 {
-            UsesRepr::Inline { len, uses } if (*len as usize) < uses.len() => {
-                uses[*len as usize] = item;
-                *len += 1;
-            }
-            UsesRepr::Inline { uses, .. } => {
-                let mut spilled = uses.to_vec();
-                spilled.push(item);
-                self.0 = UsesRepr::Heap(spilled);
-            }
-            UsesRepr::Heap(v) => v.push(item),
-        }
-    }
-
-    /// The uses in the order they were added.
-    pub fn as_slice(&self) -> &[(TriId, u8)] {
-        match &self.0 {
-            UsesRepr::Inline { len, uses } => &uses[..*len as usize],
-            UsesRepr::Heap(v) => v,
-        }
-    }
-}
-
-impl Default for EdgeUses {
-    fn default() -> Self {
-        EdgeUses::new()
-    }
-}
-
-impl std::ops::Deref for EdgeUses {
-    type Target = [(TriId, u8)];
-    fn deref(&self) -> &Self::Target {
-        self.as_slice()
-    }
-}
-
-impl<'a> IntoIterator for &'a EdgeUses {
-    type Item = &'a (TriId, u8);
-    type IntoIter = std::slice::Iter<'a, (TriId, u8)>;
-    fn into_iter(self) -> Self::IntoIter {
-        self.as_slice().iter()
-    }
-}
-
-impl PartialEq for EdgeUses {
-    fn eq(&self, other: &Self) -> bool {
-        self.as_slice() == other.as_slice()
-    }
-}
-
-impl Eq for EdgeUses {}
 
 /// The triangle across an interior edge, with the local slots that locate it (notes item 3).
 ///
@@ -144,6 +95,17 @@ pub struct Neighbour {
     /// `[p, q, r]`, local corner slots of g.
     pub slots: [u8; 3],
 }
+
+/// A [`Neighbour`] in one `u32`: `2 × (3g + r) + swapped`, where `r` is g's corner opposite the
+/// shared edge and `swapped` says f's corner `i` sits in g's slot `r + 2` rather than `r + 1`;
+/// [`NO_NEIGHBOUR`] for edges that are not interior. A third of the `Option<Neighbour>` it
+/// replaces, which padded every entry to 12 bytes.
+type PackedNeighbour = u32;
+const NO_NEIGHBOUR: PackedNeighbour = u32::MAX;
+
+/// The most triangles one [`Topology`] holds: a packed neighbour spends `6 × triangles` of a
+/// `u32` (over 700 million triangles, beyond what fits the memory of any machine this runs on).
+pub const MAX_TRIANGLES: usize = (u32::MAX / 6) as usize;
 
 /// Something odd in the geometry, with the fallback that was applied.
 #[derive(Debug, Clone, PartialEq)]
@@ -191,7 +153,12 @@ impl fmt::Display for Warning {
     }
 }
 
-/// Welded adjacency of a [`TriMesh`].
+/// Welded adjacency of a [`TriMesh`], held as flat arrays indexed by `u32` ids.
+///
+/// Every per-edge fact is its own array (structure of arrays) and the uses of all edges share
+/// one array cut by offsets (compressed rows), so a mesh of any shape costs a fixed number of
+/// allocations and about 90 bytes per triangle; [`Topology::edge`] assembles a small [`Edge`]
+/// view on demand.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Topology {
     /// Input vertex index to welded vertex (bit-equal positions; -0.0 equals +0.0).
@@ -200,14 +167,22 @@ pub struct Topology {
     pub welded_positions: Vec<DVec3>,
     /// Welded corners per triangle, in input corner order.
     pub tri_verts: Vec<[VertId; 3]>,
-    /// One per welded edge, sorted by `verts`.
-    pub edges: Vec<Edge>,
     /// `tri_edges[t][k]` is the edge opposite corner `k` of triangle `t`.
     pub tri_edges: Vec<[EdgeId; 3]>,
-    /// `neighbours[t][k]`: the triangle across edge `k` of `t`, for interior edges only.
-    pub neighbours: Vec<[Option<Neighbour>; 3]>,
     /// Degenerate triangles (two welded corners or zero area).
     pub degenerate: Vec<bool>,
+    /// Per edge: end points, smaller id first; edges are sorted by them.
+    edge_verts: Vec<[VertId; 2]>,
+    /// Per edge: its classification.
+    edge_kinds: Vec<EdgeKind>,
+    /// Per edge: whether its triangles disagree on an input normal at an end point.
+    split_normals: Vec<bool>,
+    /// The uses of edge `e` are `uses[use_start[e]..use_start[e + 1]]`.
+    use_start: Vec<u32>,
+    /// Every edge's uses, edge after edge, each edge's in (triangle, corner) order.
+    uses: Vec<EdgeUse>,
+    /// Per triangle and edge: the triangle across it ([`PackedNeighbour`]).
+    neighbours: Vec<[PackedNeighbour; 3]>,
 }
 
 /// A triangle counts as zero-area when |cross| <= this × (longest edge)²: a few ulps of the
@@ -215,96 +190,176 @@ pub struct Topology {
 const ZERO_AREA_RELATIVE: f64 = 1e-14;
 
 impl Topology {
-    /// Welds `mesh` and builds its edges. Never fails: odd geometry is classified, not rejected.
+    /// Welds `mesh` and builds its edges. Never fails on odd geometry: it is classified, not
+    /// rejected.
+    ///
+    /// Every pass is linear in the corners (a counting sort groups the uses of each edge, and
+    /// only the uses that share a smaller end point are sorted among themselves), and the
+    /// per-edge and per-triangle passes run in parallel; the result does not depend on the
+    /// thread count.
+    ///
+    /// # Panics
+    /// With more than [`MAX_TRIANGLES`] triangles (the caller checks the input first).
     pub fn build(mesh: &TriMesh) -> Topology {
+        assert!(
+            mesh.triangles.len() <= MAX_TRIANGLES,
+            "a topology holds at most {MAX_TRIANGLES} triangles"
+        );
         let (welded_of_vertex, welded_positions) = weld(&mesh.positions);
         let tri_verts: Vec<[VertId; 3]> = mesh
             .triangles
-            .iter()
+            .par_iter()
             .map(|t| t.map(|c| welded_of_vertex[c as usize]))
             .collect();
         let degenerate: Vec<bool> = tri_verts
-            .iter()
+            .par_iter()
             .map(|v| is_degenerate(v, &welded_positions))
             .collect();
+        let Grouped {
+            uses,
+            edge_verts,
+            use_start,
+            tri_edges,
+        } = group_uses(&tri_verts, welded_positions.len());
 
-        // Every half-edge as (canonical key, triangle, opposite corner); sorting groups the
-        // uses of one edge together and puts edges in canonical order.
-        let mut half: Vec<([VertId; 2], TriId, u8)> = Vec::with_capacity(3 * tri_verts.len());
-        for (t, v) in tri_verts.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (v[(k + 1) % 3], v[(k + 2) % 3]);
-                half.push(([a.min(b), a.max(b)], TriId(t as u32), k as u8));
-            }
-        }
-        // Entries are distinct, so the parallel sort's result is the one order there is.
-        half.par_sort_unstable();
+        let uses_of = |e: usize| &uses[use_start[e] as usize..use_start[e + 1] as usize];
+        let (edge_kinds, split_normals): (Vec<EdgeKind>, Vec<bool>) = (0..edge_verts.len())
+            .into_par_iter()
+            .map(|e| {
+                let (verts, tris) = (edge_verts[e], uses_of(e));
+                let uses_degenerate = tris.iter().any(|u| degenerate[u.tri().0 as usize]);
+                let kind = if verts[0] == verts[1] || uses_degenerate {
+                    EdgeKind::Degenerate
+                } else {
+                    match tris.len() {
+                        1 => EdgeKind::Boundary,
+                        2 => EdgeKind::Interior,
+                        _ => EdgeKind::NonManifold,
+                    }
+                };
+                (kind, has_split_normals(verts, tris, mesh, &tri_verts))
+            })
+            .unzip();
 
-        // A closed mesh has half as many edges as half-edges; an open one grows the vector.
-        let mut edges: Vec<Edge> = Vec::with_capacity(half.len() / 2);
-        let mut tri_edges = vec![[EdgeId(0); 3]; tri_verts.len()];
-        for (key, t, k) in half {
-            if edges.last().is_none_or(|e| e.verts != key) {
-                edges.push(Edge {
-                    verts: key,
-                    kind: EdgeKind::Boundary,
-                    tris: EdgeUses::new(),
-                    split_normals: false,
-                });
-            }
-            let id = EdgeId(edges.len() as u32 - 1);
-            edges.last_mut().expect("just pushed").tris.push((t, k));
-            tri_edges[t.0 as usize][k as usize] = id;
-        }
-
-        let mut neighbours = vec![[None; 3]; tri_verts.len()];
-        for edge in &mut edges {
-            let uses_degenerate = edge.tris.iter().any(|&(t, _)| degenerate[t.0 as usize]);
-            edge.kind = if edge.verts[0] == edge.verts[1] || uses_degenerate {
-                EdgeKind::Degenerate
-            } else {
-                match edge.tris.len() {
-                    1 => EdgeKind::Boundary,
-                    2 => EdgeKind::Interior,
-                    _ => EdgeKind::NonManifold,
-                }
-            };
-            edge.split_normals = has_split_normals(edge, mesh, &tri_verts);
-            if edge.kind == EdgeKind::Interior {
-                let [(f, kf), (g, kg)] = [edge.tris[0], edge.tris[1]];
-                neighbours[f.0 as usize][kf as usize] = Some(neighbour(&tri_verts, f, kf, g, kg));
-                neighbours[g.0 as usize][kg as usize] = Some(neighbour(&tri_verts, g, kg, f, kf));
-            }
-        }
+        let neighbours: Vec<[PackedNeighbour; 3]> = (0..tri_verts.len())
+            .into_par_iter()
+            .map(|f| {
+                std::array::from_fn(|kf| {
+                    let e = tri_edges[f][kf].0 as usize;
+                    if edge_kinds[e] != EdgeKind::Interior {
+                        return NO_NEIGHBOUR;
+                    }
+                    let here = EdgeUse::new(TriId(f as u32), kf as u8);
+                    let pair = uses_of(e);
+                    let other = if pair[0] == here { pair[1] } else { pair[0] };
+                    let (g, kg) = other.at();
+                    // f's corner i sits in g's slot r + 1 or r + 2 (r = kg, opposite the edge).
+                    let i = tri_verts[f][(kf + 1) % 3];
+                    let swapped = tri_verts[g][(kg + 1) % 3] != i;
+                    (other.0 << 1) | u32::from(swapped)
+                })
+            })
+            .collect();
 
         Topology {
             welded_of_vertex,
             welded_positions,
             tri_verts,
-            edges,
             tri_edges,
-            neighbours,
             degenerate,
+            edge_verts,
+            edge_kinds,
+            split_normals,
+            use_start,
+            uses,
+            neighbours,
         }
+    }
+
+    /// The number of welded edges; [`EdgeId`]s run from 0 to this.
+    pub fn edge_count(&self) -> usize {
+        self.edge_verts.len()
+    }
+
+    /// The edge with this id.
+    pub fn edge(&self, id: EdgeId) -> Edge<'_> {
+        let e = id.0 as usize;
+        Edge {
+            verts: self.edge_verts[e],
+            kind: self.edge_kinds[e],
+            tris: self.edge_uses(id),
+            split_normals: self.split_normals[e],
+        }
+    }
+
+    /// Every edge in id order.
+    pub fn edges(&self) -> impl ExactSizeIterator<Item = Edge<'_>> + Clone + '_ {
+        (0..self.edge_count()).map(|e| self.edge(EdgeId(e as u32)))
+    }
+
+    /// Every edge in id order, in parallel.
+    pub fn par_edges(&self) -> impl IndexedParallelIterator<Item = Edge<'_>> + '_ {
+        (0..self.edge_count())
+            .into_par_iter()
+            .map(|e| self.edge(EdgeId(e as u32)))
+    }
+
+    /// The classification of edge `id` alone (no view assembled).
+    pub fn edge_kind(&self, id: EdgeId) -> EdgeKind {
+        self.edge_kinds[id.0 as usize]
+    }
+
+    /// The end points of edge `id`, smaller id first.
+    pub fn edge_verts(&self, id: EdgeId) -> [VertId; 2] {
+        self.edge_verts[id.0 as usize]
+    }
+
+    /// The uses of edge `id`, in (triangle, corner) order.
+    pub fn edge_uses(&self, id: EdgeId) -> &[EdgeUse] {
+        let e = id.0 as usize;
+        &self.uses[self.use_start[e] as usize..self.use_start[e + 1] as usize]
     }
 
     /// The welded edge between two welded vertices, if there is one.
     pub fn edge_between(&self, a: VertId, b: VertId) -> Option<EdgeId> {
         let key = [a.min(b), a.max(b)];
-        self.edges
-            .binary_search_by(|e| e.verts.cmp(&key))
+        self.edge_verts
+            .binary_search(&key)
             .ok()
             .map(|i| EdgeId(i as u32))
     }
 
-    /// The edge with this id.
-    pub fn edge(&self, id: EdgeId) -> &Edge {
-        &self.edges[id.0 as usize]
-    }
-
     /// The triangle across edge `k` of `tri`, if that edge is interior.
     pub fn neighbour(&self, tri: TriId, k: usize) -> Option<Neighbour> {
-        self.neighbours[tri.0 as usize][k]
+        let code = self.neighbours[tri.0 as usize][k];
+        if code == NO_NEIGHBOUR {
+            return None;
+        }
+        let (g, r) = EdgeUse(code >> 1).at();
+        let (p, q) = ((r + 1) % 3, (r + 2) % 3);
+        let (p, q) = if code & 1 == 0 { (p, q) } else { (q, p) };
+        Some(Neighbour {
+            tri: TriId(g as u32),
+            slots: [p as u8, q as u8, r as u8],
+        })
+    }
+
+    /// Bytes this topology holds on the heap (capacities, not lengths).
+    pub fn heap_bytes(&self) -> usize {
+        fn held<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        held(&self.welded_of_vertex)
+            + held(&self.welded_positions)
+            + held(&self.tri_verts)
+            + held(&self.tri_edges)
+            + held(&self.degenerate)
+            + held(&self.edge_verts)
+            + held(&self.edge_kinds)
+            + held(&self.split_normals)
+            + held(&self.use_start)
+            + held(&self.uses)
+            + held(&self.neighbours)
     }
 
     /// Degenerate triangles and non-manifold edges, in index order.
@@ -318,8 +373,7 @@ impl Topology {
                 tri: TriId(t as u32),
             });
         let edges = self
-            .edges
-            .iter()
+            .edges()
             .enumerate()
             .filter(|(_, e)| e.kind == EdgeKind::NonManifold)
             .map(|(i, e)| Warning::NonManifoldEdge {
@@ -331,21 +385,117 @@ impl Topology {
 }
 
 /// Welds bit-equal positions (after mapping -0.0 to +0.0), numbering them by first use.
+///
+/// Sorting (key, index) pairs groups equal positions with their first use at the head: half
+/// the memory of a hash map over every vertex, and parallel.
 fn weld(positions: &[DVec3]) -> (Vec<VertId>, Vec<DVec3>) {
-    let mut index: HashMap<[u64; 3], VertId> = HashMap::with_capacity(positions.len());
-    let mut welded = Vec::new();
-    let of_vertex = positions
-        .iter()
-        .map(|p| {
-            // x + 0.0 is +0.0 for x = -0.0 and x itself otherwise.
-            let key = [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
-            *index.entry(key).or_insert_with(|| {
-                welded.push(*p);
-                VertId(welded.len() as u32 - 1)
-            })
-        })
+    // x + 0.0 is +0.0 for x = -0.0 and x itself otherwise.
+    let key = |p: &DVec3| [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
+    let mut sorted: Vec<([u64; 3], u32)> = positions
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| (key(p), i as u32))
         .collect();
-    (of_vertex, welded)
+    // Entries are distinct (the index differs), so the parallel sort's order is the one there is.
+    sorted.par_sort_unstable();
+    // `first[i]`: the first input vertex at vertex i's position.
+    let mut first = vec![0u32; positions.len()];
+    let mut distinct = 0;
+    for group in sorted.chunk_by(|a, b| a.0 == b.0) {
+        distinct += 1;
+        for &(_, i) in group {
+            first[i as usize] = group[0].1;
+        }
+    }
+    drop(sorted);
+    // In input order each first use takes the next id, and every later use (whose first use
+    // came before it) copies that id, in place.
+    let mut welded = Vec::with_capacity(distinct);
+    for i in 0..first.len() {
+        let r = first[i] as usize;
+        first[i] = if r == i {
+            welded.push(positions[i]);
+            welded.len() as u32 - 1
+        } else {
+            first[r]
+        };
+    }
+    (first.into_iter().map(VertId).collect(), welded)
+}
+
+/// The uses of all edges grouped edge by edge, and what indexes them.
+struct Grouped {
+    uses: Vec<EdgeUse>,
+    edge_verts: Vec<[VertId; 2]>,
+    use_start: Vec<u32>,
+    tri_edges: Vec<[EdgeId; 3]>,
+}
+
+/// Groups every triangle side into welded edges, in canonical (smaller vertex, larger vertex)
+/// order and each edge's uses in (triangle, corner) order.
+///
+/// A counting sort by the smaller end point puts the uses into one bucket per vertex, already
+/// in use order; each bucket is then sorted by the larger end point alone. Linear in the corners
+/// plus the sort of each vertex's own sides, where a sort of all sides together kept 16-byte
+/// keys for every side.
+fn group_uses(tri_verts: &[[VertId; 3]], vertex_count: usize) -> Grouped {
+    let key = |u: EdgeUse| {
+        let (t, k) = u.at();
+        let (a, b) = (tri_verts[t][(k + 1) % 3], tri_verts[t][(k + 2) % 3]);
+        [a.min(b), a.max(b)]
+    };
+    let all = 3 * tri_verts.len();
+    // Bucket ends by smaller end point, then filled backwards so each bucket keeps use order.
+    let mut end = vec![0u32; vertex_count + 1];
+    for v in tri_verts {
+        for k in 0..3 {
+            let (a, b) = (v[(k + 1) % 3], v[(k + 2) % 3]);
+            end[a.min(b).0 as usize] += 1;
+        }
+    }
+    let mut sum = 0;
+    for x in &mut end {
+        sum += *x;
+        *x = sum;
+    }
+    let mut uses = vec![EdgeUse(0); all];
+    for c in (0..all as u32).rev() {
+        let u = EdgeUse(c);
+        let slot = &mut end[key(u)[0].0 as usize];
+        *slot -= 1;
+        uses[*slot as usize] = u;
+    }
+    drop(end);
+    uses.par_chunk_by_mut(|&a, &b| key(a)[0] == key(b)[0])
+        .for_each(|bucket| bucket.sort_unstable_by_key(|&u| (key(u)[1], u)));
+
+    let edge_count = if uses.is_empty() {
+        0
+    } else {
+        1 + (1..all)
+            .into_par_iter()
+            .filter(|&i| key(uses[i]) != key(uses[i - 1]))
+            .count()
+    };
+    let mut edge_verts = Vec::with_capacity(edge_count);
+    let mut use_start = Vec::with_capacity(edge_count + 1);
+    let mut tri_edges = vec![[EdgeId(0); 3]; tri_verts.len()];
+    for (i, &u) in uses.iter().enumerate() {
+        let k = key(u);
+        if edge_verts.last() != Some(&k) {
+            edge_verts.push(k);
+            use_start.push(i as u32);
+        }
+        let (t, c) = u.at();
+        tri_edges[t][c] = EdgeId(edge_verts.len() as u32 - 1);
+    }
+    use_start.push(all as u32);
+    Grouped {
+        uses,
+        edge_verts,
+        use_start,
+        tri_edges,
+    }
 }
 
 fn is_degenerate(v: &[VertId; 3], positions: &[DVec3]) -> bool {
@@ -362,12 +512,19 @@ fn is_degenerate(v: &[VertId; 3], positions: &[DVec3]) -> bool {
     cross.partial_cmp(&(ZERO_AREA_RELATIVE * longest)) != Some(std::cmp::Ordering::Greater)
 }
 
-/// Whether the triangles using `edge` disagree on the input normal at either end point.
-fn has_split_normals(edge: &Edge, mesh: &TriMesh, tri_verts: &[[VertId; 3]]) -> bool {
-    edge.verts.iter().any(|&v| {
-        let mut normals = edge.tris.iter().filter_map(|&(t, _)| {
-            let corner = tri_verts[t.0 as usize].iter().position(|&c| c == v)?;
-            Some(mesh.normals[mesh.triangles[t.0 as usize][corner] as usize])
+/// Whether the triangles using an edge (`verts`, `tris`) disagree on the input normal at
+/// either end point.
+fn has_split_normals(
+    verts: [VertId; 2],
+    tris: &[EdgeUse],
+    mesh: &TriMesh,
+    tri_verts: &[[VertId; 3]],
+) -> bool {
+    verts.iter().any(|&v| {
+        let mut normals = tris.iter().filter_map(|u| {
+            let t = u.tri().0 as usize;
+            let corner = tri_verts[t].iter().position(|&c| c == v)?;
+            Some(mesh.normals[mesh.triangles[t][corner] as usize])
         });
         match normals.next() {
             Some(first) => normals.any(|n| n != first),
@@ -376,37 +533,26 @@ fn has_split_normals(edge: &Edge, mesh: &TriMesh, tri_verts: &[[VertId; 3]]) -> 
     })
 }
 
-/// Slots of g (whose edge `kg` is f's edge `kf`) holding f's corners i, j and g's third corner.
-fn neighbour(tri_verts: &[[VertId; 3]], f: TriId, kf: u8, g: TriId, kg: u8) -> Neighbour {
-    let vf = tri_verts[f.0 as usize];
-    let vg = tri_verts[g.0 as usize];
-    let i = vf[(kf as usize + 1) % 3];
-    let slot_of = |v: VertId| vg.iter().position(|&c| c == v).expect("shared corner") as u8;
-    Neighbour {
-        tri: g,
-        slots: if slot_of(i) == (kg + 1) % 3 {
-            [(kg + 1) % 3, (kg + 2) % 3, kg]
-        } else {
-            [(kg + 2) % 3, (kg + 1) % 3, kg]
-        },
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn edge_uses_keep_their_order_inline_and_spilled() {
-        let mut uses = EdgeUses::new();
-        assert!(uses.is_empty());
-        let all: Vec<(TriId, u8)> = (0..5).map(|t| (TriId(10 - t), (t % 3) as u8)).collect();
-        for (n, &u) in all.iter().enumerate() {
-            uses.push(u);
-            assert_eq!(uses.as_slice(), &all[..=n]);
-        }
-        assert_eq!(uses.iter().count(), 5);
-        assert_eq!((&uses).into_iter().copied().collect::<Vec<_>>(), all);
+    fn edge_uses_pack_triangle_and_corner_in_order() {
+        let all: Vec<EdgeUse> = [
+            (0, 2),
+            (1, 0),
+            (1, 1),
+            (7, 2),
+            (MAX_TRIANGLES as u32 - 1, 2),
+        ]
+        .iter()
+        .map(|&(t, k)| EdgeUse::new(TriId(t), k))
+        .collect();
+        assert!(all.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!(all[3].tri(), TriId(7));
+        assert_eq!(all[3].corner(), 2);
+        assert_eq!(all[4].at(), (MAX_TRIANGLES - 1, 2));
     }
 
     fn quad() -> TriMesh {
@@ -435,7 +581,7 @@ mod tests {
     #[test]
     fn finds_the_shared_diagonal_with_its_slots() {
         let topo = Topology::build(&quad());
-        assert_eq!(topo.edges.len(), 5);
+        assert_eq!(topo.edge_count(), 5);
         // Edge 1 of triangle 0 runs from its corner 2 to corner 0 (the diagonal).
         let n = topo.neighbour(TriId(0), 1).expect("diagonal is interior");
         assert_eq!(n.tri, TriId(1));
@@ -444,7 +590,7 @@ mod tests {
         let diag = topo.edge(topo.tri_edges[0][1]);
         assert_eq!(diag.kind, EdgeKind::Interior);
         assert!(diag.split_normals);
-        let boundary = topo.edges.iter().filter(|e| e.kind == EdgeKind::Boundary);
+        let boundary = topo.edges().filter(|e| e.kind == EdgeKind::Boundary);
         assert_eq!(boundary.count(), 4);
     }
 
@@ -481,5 +627,180 @@ mod tests {
         assert_eq!(topo.edge(diag).kind, EdgeKind::Degenerate);
         let w = topo.warnings();
         assert_eq!(w, vec![Warning::DegenerateTriangle { tri: TriId(3) }]);
+    }
+
+    /// Each edge's end points and uses, one vector per edge.
+    type EdgeList = Vec<([VertId; 2], Vec<EdgeUse>)>;
+
+    /// The adjacency rebuilt the obvious way (ordered maps, one vector per edge), to check the
+    /// flat arrays against.
+    fn reference(mesh: &TriMesh) -> (Vec<VertId>, EdgeList) {
+        let mut ids = std::collections::BTreeMap::new();
+        let welded: Vec<VertId> = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                let key = [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
+                let next = VertId(ids.len() as u32);
+                *ids.entry(key).or_insert(next)
+            })
+            .collect();
+        let mut edges = std::collections::BTreeMap::<[VertId; 2], Vec<EdgeUse>>::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (
+                    welded[tri[(k + 1) % 3] as usize],
+                    welded[tri[(k + 2) % 3] as usize],
+                );
+                edges
+                    .entry([a.min(b), a.max(b)])
+                    .or_default()
+                    .push(EdgeUse::new(TriId(t as u32), k as u8));
+            }
+        }
+        (welded, edges.into_iter().collect())
+    }
+
+    /// Odd shapes on few positions: books (many triangles on one edge), fans, duplicates in
+    /// every corner order, degenerate and open triangles, signed zeros.
+    fn odd_mesh(seed: u64, tris: usize) -> TriMesh {
+        let mut state = seed;
+        let mut next = move |n: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % n
+        };
+        let positions: Vec<DVec3> = (0..24)
+            .map(|_| {
+                let c = |x: u64| if x == 0 { -0.0 } else { x as f64 - 1.0 };
+                DVec3::new(c(next(3)), c(next(3)), c(next(2)))
+            })
+            .collect();
+        let normals = (0..positions.len())
+            .map(|i| if i % 5 == 0 { DVec3::X } else { DVec3::Z })
+            .collect();
+        let mut triangles = Vec::new();
+        while triangles.len() < tris {
+            let t = [next(24), next(24), next(24)].map(|v| v as u32);
+            match next(4) {
+                0 => triangles.push([0, 1, t[2]]),
+                1 => triangles.push([3, t[1], t[2]]),
+                _ => triangles.push(t),
+            }
+            if next(5) == 0 {
+                triangles.push([t[1], t[0], t[2]]);
+            }
+        }
+        TriMesh {
+            positions,
+            normals,
+            triangles,
+        }
+    }
+
+    #[test]
+    fn flat_arrays_match_the_obvious_adjacency_on_odd_shapes() {
+        for seed in 0..40 {
+            let mesh = odd_mesh(seed, 10 + 7 * seed as usize);
+            let topo = Topology::build(&mesh);
+            let (welded, edges) = reference(&mesh);
+            assert_eq!(topo.welded_of_vertex, welded);
+            assert_eq!(topo.edge_count(), edges.len());
+            for (e, (verts, uses)) in edges.iter().enumerate() {
+                let edge = topo.edge(EdgeId(e as u32));
+                assert_eq!((edge.verts, edge.tris), (*verts, uses.as_slice()));
+                assert_eq!(
+                    topo.edge_between(verts[1], verts[0]),
+                    Some(EdgeId(e as u32))
+                );
+                for u in uses {
+                    assert_eq!(topo.tri_edges[u.at().0][u.at().1], EdgeId(e as u32));
+                }
+                let degenerate =
+                    verts[0] == verts[1] || uses.iter().any(|u| topo.degenerate[u.at().0]);
+                let kind = match uses.len() {
+                    _ if degenerate => EdgeKind::Degenerate,
+                    1 => EdgeKind::Boundary,
+                    2 => EdgeKind::Interior,
+                    _ => EdgeKind::NonManifold,
+                };
+                assert_eq!(edge.kind, kind, "seed {seed} edge {e}");
+                // The neighbour across an interior edge holds the same two welded corners in the
+                // slots it names, and its third corner in the last.
+                for u in uses {
+                    let (f, k) = u.at();
+                    let n = topo.neighbour(u.tri(), k);
+                    assert_eq!(n.is_some(), kind == EdgeKind::Interior);
+                    let Some(n) = n else { continue };
+                    let other = uses.iter().find(|x| *x != u).expect("two uses");
+                    assert_eq!(n.tri, other.tri());
+                    let (vf, vg) = (topo.tri_verts[f], topo.tri_verts[n.tri.0 as usize]);
+                    assert_eq!(vg[n.slots[0] as usize], vf[(k + 1) % 3]);
+                    assert_eq!(vg[n.slots[1] as usize], vf[(k + 2) % 3]);
+                    assert_eq!(n.slots[2], other.corner());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_book_of_many_pages_is_one_non_manifold_edge() {
+        let mut mesh = TriMesh {
+            positions: vec![DVec3::ZERO, DVec3::X],
+            ..TriMesh::default()
+        };
+        for p in 0..500 {
+            let a = f64::from(p) * 0.01;
+            mesh.positions.push(DVec3::new(0.5, a.cos(), a.sin()));
+            mesh.triangles.push([0, 1, p + 2]);
+        }
+        mesh.normals = vec![DVec3::Z; mesh.positions.len()];
+        let topo = Topology::build(&mesh);
+        let spine = topo.edge_between(VertId(0), VertId(1)).expect("spine");
+        assert_eq!(topo.edge(spine).kind, EdgeKind::NonManifold);
+        assert_eq!(topo.edge_uses(spine).len(), 500);
+        assert_eq!(topo.edge_count(), 1 + 2 * 500);
+        assert!((0..500).all(|t| topo.neighbour(TriId(t), 2).is_none()));
+    }
+
+    #[test]
+    fn an_empty_mesh_has_no_edges() {
+        let topo = Topology::build(&TriMesh::default());
+        assert_eq!((topo.edge_count(), topo.edges().count()), (0, 0));
+        assert!(topo.warnings().is_empty());
+    }
+
+    #[test]
+    fn every_array_is_sized_exactly_84_bytes_a_triangle_on_a_closed_mesh() {
+        // A torus of m × n quads: V = mn vertices, T = 2mn triangles, E = 3mn edges.
+        let (m, n) = (40u32, 25u32);
+        let at = |i: u32, j: u32| (i % m) * n + (j % n);
+        let mut mesh = TriMesh::default();
+        for i in 0..m {
+            for j in 0..n {
+                let (u, v) = (
+                    f64::from(i) * std::f64::consts::TAU / f64::from(m),
+                    f64::from(j) * std::f64::consts::TAU / f64::from(n),
+                );
+                let r = 2.0 + v.cos();
+                mesh.positions
+                    .push(DVec3::new(r * u.cos(), r * u.sin(), v.sin()));
+                mesh.triangles
+                    .push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                mesh.triangles
+                    .push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        mesh.normals = vec![DVec3::Z; mesh.positions.len()];
+        let topo = Topology::build(&mesh);
+        let (v, t, e) = ((m * n) as usize, (2 * m * n) as usize, (3 * m * n) as usize);
+        assert_eq!(topo.edge_count(), e);
+        assert!(topo.edges().all(|e| e.kind == EdgeKind::Interior));
+        // Per vertex: its welded id and position (4 + 24); per triangle: corners, edges,
+        // neighbours, uses (12 each) and the degenerate flag; per edge: end points, kind, split
+        // flag and use offset (8 + 1 + 1 + 4), plus the closing offset.
+        assert_eq!(topo.heap_bytes(), 28 * v + 49 * t + 14 * e + 4);
+        assert_eq!(topo.heap_bytes() / t, 84);
     }
 }

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use super::warning::Warning;
 use crate::mesh::TriMesh;
-use crate::topology::{EdgeKind, Topology};
+use crate::topology::{EdgeId, EdgeKind, EdgeUse, Topology};
 
 /// Triangles whose smallest angle is below this (in radians, about 0.06°) are slivers: valid,
 /// but their normals and parameterization are numerically fragile.
@@ -28,36 +28,33 @@ const EXAMPLES: usize = 3;
 /// `index`), each naming the fallback applied.
 pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warning> {
     let mut out = Vec::new();
-    let degenerate: Vec<usize> = (0..topo.degenerate.len())
-        .filter(|&t| topo.degenerate[t])
-        .collect();
-    if !degenerate.is_empty() {
+    let degenerate = Tally::of(topo.degenerate.len(), |t| topo.degenerate[t]);
+    if degenerate.count > 0 {
         out.push(Warning::DegenerateTriangles {
             mesh: index,
-            count: degenerate.len(),
-            triangles: first(&degenerate),
+            count: degenerate.count,
+            triangles: degenerate.examples().to_vec(),
         });
     }
 
     let sliver_cos = SLIVER_ANGLE.cos();
-    let slivers: Vec<usize> = (0..mesh.triangles.len())
-        .into_par_iter()
-        .filter(|&t| !topo.degenerate[t] && largest_angle_cosine(mesh, t) > sliver_cos)
-        .collect();
-    if !slivers.is_empty() {
+    let slivers = Tally::of(mesh.triangles.len(), |t| {
+        !topo.degenerate[t] && largest_angle_cosine(mesh, t) > sliver_cos
+    });
+    if slivers.count > 0 {
         out.push(Warning::SliverTriangles {
             mesh: index,
-            count: slivers.len(),
-            triangles: first(&slivers),
+            count: slivers.count,
+            triangles: slivers.examples().to_vec(),
         });
     }
 
     let duplicates = duplicate_triangles(topo);
-    if !duplicates.is_empty() {
+    if duplicates.count > 0 {
         out.push(Warning::DuplicateTriangles {
             mesh: index,
-            count: duplicates.len(),
-            triangles: first(&duplicates),
+            count: duplicates.count,
+            triangles: duplicates.examples().to_vec(),
         });
     }
 
@@ -67,75 +64,73 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
             used[c as usize] = true;
         }
     }
-    let unused: Vec<usize> = (0..used.len()).filter(|&v| !used[v]).collect();
-    if !unused.is_empty() {
+    let unused = Tally::of(used.len(), |v| !used[v]);
+    drop(used);
+    if unused.count > 0 {
         out.push(Warning::UnusedVertices {
             mesh: index,
-            count: unused.len(),
-            vertices: first(&unused),
+            count: unused.count,
+            vertices: unused.examples().to_vec(),
         });
     }
 
-    let facing_away: Vec<usize> = (0..mesh.triangles.len())
-        .into_par_iter()
-        .filter(|&t| {
-            let tri = mesh.triangles[t];
-            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
-            let face = (b - a).cross(c - a);
-            !topo.degenerate[t]
-                && tri
-                    .iter()
-                    .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
-        })
-        .collect();
-    if !facing_away.is_empty() {
+    let facing_away = Tally::of(mesh.triangles.len(), |t| {
+        let tri = mesh.triangles[t];
+        let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+        let face = (b - a).cross(c - a);
+        !topo.degenerate[t]
+            && tri
+                .iter()
+                .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
+    });
+    if facing_away.count > 0 {
         out.push(Warning::NormalsFacingAway {
             mesh: index,
-            count: facing_away.len(),
-            triangles: first(&facing_away),
+            count: facing_away.count,
+            triangles: facing_away.examples().to_vec(),
         });
     }
 
-    let count = |kind: EdgeKind| topo.edges.iter().filter(|e| e.kind == kind).count();
-    let boundary = count(EdgeKind::Boundary);
+    let kind_of = |e: usize| topo.edge_kind(EdgeId(e as u32));
+    let boundary = Tally::of(topo.edge_count(), |e| kind_of(e) == EdgeKind::Boundary).count;
     if boundary > 0 {
         out.push(Warning::BoundaryEdges {
             mesh: index,
             count: boundary,
         });
     }
-    let non_manifold: Vec<usize> = (0..topo.edges.len())
-        .filter(|&e| topo.edges[e].kind == EdgeKind::NonManifold)
-        .collect();
-    if !non_manifold.is_empty() {
+    let non_manifold = Tally::of(topo.edge_count(), |e| kind_of(e) == EdgeKind::NonManifold);
+    if non_manifold.count > 0 {
         out.push(Warning::NonManifoldEdges {
             mesh: index,
-            count: non_manifold.len(),
-            edges: first(&non_manifold),
+            count: non_manifold.count,
+            edges: non_manifold.examples().to_vec(),
         });
     }
 
-    let flipped: Vec<usize> = (0..topo.edges.len())
-        .filter(|&e| topo.edges[e].kind == EdgeKind::Interior && same_direction(topo, e))
-        .collect();
-    if !flipped.is_empty() {
+    let flipped = Tally::of(topo.edge_count(), |e| {
+        kind_of(e) == EdgeKind::Interior && same_direction(topo, e)
+    });
+    if flipped.count > 0 {
         out.push(Warning::OppositeWindingEdges {
             mesh: index,
-            count: flipped.len(),
-            edges: first(&flipped),
+            count: flipped.count,
+            edges: flipped.examples().to_vec(),
         });
     }
 
-    let bow_ties = bow_tie_vertices(topo);
-    if !bow_ties.is_empty() {
+    // One union-find buffer serves both connectivity passes.
+    let mut parent = Vec::new();
+    let bow_ties = bow_tie_vertices(topo, &mut parent);
+    if bow_ties.count > 0 {
         out.push(Warning::BowTieVertices {
             mesh: index,
-            count: bow_ties.len(),
-            vertices: first(&bow_ties),
+            count: bow_ties.count,
+            vertices: bow_ties.examples().to_vec(),
         });
     }
 
-    let pieces = pieces(topo);
+    let pieces = pieces(topo, &mut parent);
     if pieces > MANY_PIECES {
         out.push(Warning::ManyPieces {
             mesh: index,
@@ -145,9 +140,47 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
     out
 }
 
-/// The first few of `v`, as examples.
-fn first(v: &[usize]) -> Vec<usize> {
-    v[..v.len().min(EXAMPLES)].to_vec()
+/// How many indices passed a test, and the first [`EXAMPLES`] of them, found without listing
+/// them all (a scan of a million bad triangles keeps three).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Tally {
+    count: usize,
+    first: [usize; EXAMPLES],
+}
+
+impl Tally {
+    /// The indices in `0..n` for which `hit` holds, tested in parallel; the examples are the
+    /// smallest whatever the thread count (parts are merged in index order).
+    fn of(n: usize, hit: impl Fn(usize) -> bool + Sync) -> Tally {
+        (0..n)
+            .into_par_iter()
+            .fold(Tally::default, |mut t, i| {
+                if hit(i) {
+                    t.add(i);
+                }
+                t
+            })
+            .reduce(Tally::default, |mut a, b| {
+                for &i in b.examples() {
+                    a.add(i);
+                }
+                a.count += b.count - b.examples().len();
+                a
+            })
+    }
+
+    /// Counts `i`, keeping it as an example if it is among the smallest seen; indices must come
+    /// in ascending order.
+    fn add(&mut self, i: usize) {
+        if self.count < EXAMPLES {
+            self.first[self.count] = i;
+        }
+        self.count += 1;
+    }
+
+    fn examples(&self) -> &[usize] {
+        &self.first[..self.count.min(EXAMPLES)]
+    }
 }
 
 /// The cosine of the smallest angle of triangle `t`: comparing cosines instead of angles spares
@@ -163,9 +196,10 @@ fn largest_angle_cosine(mesh: &TriMesh, t: usize) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
-/// Triangles with the same three welded corners as an earlier triangle (in any order), in index
-/// order. Sorting the corner triples groups the copies: no hash map over every triangle.
-fn duplicate_triangles(topo: &Topology) -> Vec<usize> {
+/// Triangles with the same three welded corners as an earlier triangle (in any order). Sorting
+/// the corner triples groups the copies: no hash map over every triangle, and near-linear
+/// however many copies one triangle has.
+fn duplicate_triangles(topo: &Topology) -> Tally {
     let mut keyed: Vec<([u32; 3], u32)> = topo
         .tri_verts
         .par_iter()
@@ -178,22 +212,28 @@ fn duplicate_triangles(topo: &Topology) -> Vec<usize> {
         .collect();
     // Entries are distinct (the triangle index differs), so the order is the one there is.
     keyed.par_sort_unstable();
-    let mut out: Vec<usize> = keyed
-        .windows(2)
-        .filter(|w| w[0].0 == w[1].0)
-        .map(|w| w[1].1 as usize)
-        .collect();
-    out.sort_unstable();
-    out
+    // Every entry after the first of its group is a copy; the smallest copies are the examples.
+    let mut found = Tally::default();
+    for w in keyed.windows(2).filter(|w| w[0].0 == w[1].0) {
+        let t = w[1].1 as usize;
+        let kept = found.count.min(EXAMPLES);
+        let at = found.first[..kept].partition_point(|&x| x < t);
+        if at < EXAMPLES {
+            found.first.copy_within(at..EXAMPLES - 1, at + 1);
+            found.first[at] = t;
+        }
+        found.count += 1;
+    }
+    found
 }
 
 /// Do both triangles of interior edge `e` run along it in the same direction (one of them is
 /// wound the other way)?
 fn same_direction(topo: &Topology, e: usize) -> bool {
-    let edge = &topo.edges[e];
-    let dir = |(t, k): (crate::topology::TriId, u8)| {
-        let v = topo.tri_verts[t.0 as usize];
-        v[(k as usize + 1) % 3] == edge.verts[0]
+    let edge = topo.edge(EdgeId(e as u32));
+    let dir = |u: EdgeUse| {
+        let (t, k) = u.at();
+        topo.tri_verts[t][(k + 1) % 3] == edge.verts[0]
     };
     dir(edge.tris[0]) == dir(edge.tris[1])
 }
@@ -201,90 +241,191 @@ fn same_direction(topo: &Topology, e: usize) -> bool {
 /// Welded vertices whose triangles form more than one fan (connected through edges that contain
 /// the vertex).
 ///
-/// One union-find over every (vertex, triangle) corner: each edge joins the corners of all its
-/// triangles at each of its end points, once. Walking edges rather than triangles keeps this
-/// linear in the corners whatever the valence (a book of 100 000 triangles on one edge, or
-/// 100 000 copies of one triangle), where joining per triangle and edge use was cubic in it.
-fn bow_tie_vertices(topo: &Topology) -> Vec<usize> {
-    // The triangles around each welded vertex, in triangle order, as one array cut by offsets
-    // (one allocation instead of one per vertex).
-    let n = topo.welded_positions.len();
-    let corners = |v: &[crate::topology::VertId; 3]| {
-        let [a, b, c] = v.map(|x| x.0 as usize);
-        [
-            Some(a),
-            (b != a).then_some(b),
-            (c != a && c != b).then_some(c),
-        ]
+/// One union-find over the triangle corners (`3 × triangle + corner`, a triangle with two
+/// welded corners at one vertex counting once, by its first): every edge joins the corners of
+/// all its triangles at each of its end points, straight from its uses. Walking edges rather than
+/// triangles keeps this linear in the corners whatever the valence (a book of 100 000 triangles
+/// on one edge, or 100 000 copies of one triangle), where joining per triangle and edge use was
+/// cubic in it. A vertex is a bow-tie when its corners fall into two or more classes.
+fn bow_tie_vertices(topo: &Topology, parent: &mut Vec<u32>) -> Tally {
+    // The corner of `t` holding the welded vertex of its corner `c`: the first with it.
+    let canonical = |t: usize, c: usize| {
+        let v = topo.tri_verts[t];
+        let first = v.iter().position(|&x| x == v[c]).unwrap_or(c);
+        (3 * t + first) as u32
     };
-    let mut start = vec![0usize; n + 1];
-    for v in &topo.tri_verts {
-        for x in corners(v).into_iter().flatten() {
-            start[x + 1] += 1;
-        }
-    }
-    for i in 0..n {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start.clone();
-    let mut around = vec![0u32; start[n]];
-    for (t, v) in topo.tri_verts.iter().enumerate() {
-        for x in corners(v).into_iter().flatten() {
-            around[fill[x]] = t as u32;
-            fill[x] += 1;
-        }
-    }
-    // The slot of triangle `t` in vertex `x`'s run of `around` (sorted by triangle).
-    let slot = |x: usize, t: u32| {
-        let run = &around[start[x]..start[x + 1]];
-        start[x] + run.binary_search(&t).expect("the triangle uses the vertex")
-    };
-    let mut parent: Vec<usize> = (0..around.len()).collect();
-    for e in &topo.edges {
-        let [a, b] = e.verts.map(|v| v.0 as usize);
-        let ends: &[usize] = if a == b { &[a] } else { &[a, b] };
-        let Some(&(first, _)) = e.tris.first() else {
+    parent.clear();
+    parent.extend(0..3 * topo.tri_verts.len() as u32);
+    for e in 0..topo.edge_count() {
+        let uses = topo.edge_uses(EdgeId(e as u32));
+        let Some((&head, rest)) = uses.split_first() else {
             continue;
         };
-        for &x in ends {
-            let s0 = slot(x, first.0);
-            for &(t, _) in &e.tris[1..] {
-                let (r0, r1) = (root(&mut parent, s0), root(&mut parent, slot(x, t.0)));
-                parent[r1] = r0;
+        let (t0, k0) = head.at();
+        for end in [1, 2] {
+            let anchor = canonical(t0, (k0 + end) % 3);
+            for u in rest {
+                let (t, k) = u.at();
+                // The use's corner at the same welded vertex as the anchor.
+                let c = if topo.tri_verts[t][(k + end) % 3] == topo.tri_verts[t0][(k0 + end) % 3] {
+                    (k + end) % 3
+                } else {
+                    (k + 3 - end) % 3
+                };
+                union(parent, anchor, canonical(t, c));
             }
         }
     }
-    (0..n)
-        .filter(|&v| {
-            (start[v]..start[v + 1])
-                .filter(|&s| root(&mut parent, s) == s)
-                .nth(1)
-                .is_some()
-        })
-        .collect()
+    // Classes per welded vertex: its canonical corners that are roots (saturating at 2).
+    let mut classes = vec![0u8; topo.welded_positions.len()];
+    for t in 0..topo.tri_verts.len() {
+        for c in 0..3 {
+            let corner = (3 * t + c) as u32;
+            if canonical(t, c) == corner && root(parent, corner) == corner {
+                let n = &mut classes[topo.tri_verts[t][c].0 as usize];
+                *n = n.saturating_add(1);
+            }
+        }
+    }
+    Tally::of(classes.len(), |v| classes[v] > 1)
 }
 
 /// Connected pieces of triangles (through welded edges).
-fn pieces(topo: &Topology) -> usize {
-    let n = topo.tri_verts.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    for e in &topo.edges {
-        for w in e.tris.windows(2) {
-            let (a, b) = (
-                root(&mut parent, w[0].0 .0 as usize),
-                root(&mut parent, w[1].0 .0 as usize),
-            );
-            parent[a] = b;
+fn pieces(topo: &Topology, parent: &mut Vec<u32>) -> usize {
+    let n = topo.tri_verts.len() as u32;
+    parent.clear();
+    parent.extend(0..n);
+    for e in 0..topo.edge_count() {
+        for w in topo.edge_uses(EdgeId(e as u32)).windows(2) {
+            union(parent, w[0].tri().0, w[1].tri().0);
         }
     }
-    (0..n).filter(|&i| root(&mut parent, i) == i).count()
+    (0..n).filter(|&i| root(parent, i) == i).count()
+}
+
+/// Joins the classes of `a` and `b`, the larger root under the smaller.
+fn union(p: &mut [u32], a: u32, b: u32) {
+    let (a, b) = (root(p, a), root(p, b));
+    p[a.max(b) as usize] = a.min(b);
 }
 
 /// The root of `i` in the union-find forest `p`, halving the path on the way.
-fn root(p: &mut [usize], mut i: usize) -> usize {
-    while p[i] != i {
-        p[i] = p[p[i]];
-        i = p[i];
+fn root(p: &mut [u32], mut i: u32) -> u32 {
+    while p[i as usize] != i {
+        p[i as usize] = p[p[i as usize] as usize];
+        i = p[i as usize];
     }
     i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::topology::VertId;
+
+    /// Books, fans, bow-ties, copies in every corner order and collapsed triangles on a few
+    /// positions.
+    fn odd_mesh(seed: u64, tris: usize) -> TriMesh {
+        let mut state = seed;
+        let mut next = move |n: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % n
+        };
+        let positions: Vec<DVec3> = (0..30)
+            .map(|_| DVec3::new(next(4) as f64, next(4) as f64, next(3) as f64))
+            .collect();
+        let mut triangles = Vec::new();
+        while triangles.len() < tris {
+            let t = [next(30), next(30), next(30)].map(|v| v as u32);
+            triangles.push(t);
+            if next(4) == 0 {
+                triangles.push([t[2], t[0], t[1]]);
+            }
+        }
+        TriMesh {
+            normals: vec![DVec3::Z; positions.len()],
+            positions,
+            triangles,
+        }
+    }
+
+    /// Bow-tie vertices the slow way: per vertex, its distinct triangles joined when they
+    /// share an edge through it, components counted by search.
+    fn bow_ties_by_search(topo: &Topology) -> Vec<usize> {
+        let n = topo.welded_positions.len();
+        (0..n)
+            .filter(|&x| {
+                let x = VertId(x as u32);
+                let around: Vec<usize> = (0..topo.tri_verts.len())
+                    .filter(|&t| topo.tri_verts[t].contains(&x))
+                    .collect();
+                let shares_edge = |a: usize, b: usize| {
+                    let [va, vb] = [topo.tri_verts[a], topo.tri_verts[b]];
+                    // An edge through x: x with another corner of a that b also has, or x
+                    // twice in a triangle (a degenerate edge from x to x) that b shares.
+                    va.iter().any(|&y| y != x && vb.contains(&y))
+                        || (va.iter().filter(|&&y| y == x).count() > 1
+                            && vb.iter().filter(|&&y| y == x).count() > 1)
+                };
+                let mut seen = vec![false; around.len()];
+                let mut pieces = 0;
+                for s in 0..around.len() {
+                    if seen[s] {
+                        continue;
+                    }
+                    pieces += 1;
+                    let mut stack = vec![s];
+                    seen[s] = true;
+                    while let Some(i) = stack.pop() {
+                        for j in 0..around.len() {
+                            if !seen[j] && shares_edge(around[i], around[j]) {
+                                seen[j] = true;
+                                stack.push(j);
+                            }
+                        }
+                    }
+                }
+                pieces > 1
+            })
+            .collect()
+    }
+
+    #[test]
+    fn bow_ties_and_duplicates_match_the_slow_definitions_on_odd_shapes() {
+        for seed in 0..30 {
+            let mesh = odd_mesh(seed, 8 + 5 * seed as usize);
+            let topo = Topology::build(&mesh);
+            let want = bow_ties_by_search(&topo);
+            let got = bow_tie_vertices(&topo, &mut Vec::new());
+            assert_eq!(got.count, want.len(), "seed {seed}");
+            assert_eq!(got.examples(), &want[..want.len().min(EXAMPLES)]);
+
+            let key = |t: usize| {
+                let mut k = topo.tri_verts[t];
+                k.sort_unstable();
+                k
+            };
+            let copies: Vec<usize> = (0..mesh.triangles.len())
+                .filter(|&t| {
+                    let k = key(t);
+                    k[0] != k[1] && k[1] != k[2] && (0..t).any(|s| key(s) == k)
+                })
+                .collect();
+            let got = duplicate_triangles(&topo);
+            assert_eq!(got.count, copies.len(), "seed {seed}");
+            assert_eq!(got.examples(), &copies[..copies.len().min(EXAMPLES)]);
+        }
+    }
+
+    #[test]
+    fn a_tally_keeps_the_smallest_examples_whatever_the_split() {
+        let hits = |i: usize| i % 7 == 3 || i > 99_990;
+        let t = Tally::of(100_000, hits);
+        assert_eq!(t.count, (0..100_000).filter(|&i| hits(i)).count());
+        assert_eq!(t.examples(), &[3, 10, 17]);
+        assert_eq!(Tally::of(10, |i| i == 9).examples(), &[9]);
+        assert_eq!(Tally::of(0, |_| true), Tally::default());
+    }
 }

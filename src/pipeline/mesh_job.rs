@@ -93,8 +93,7 @@ pub(super) fn resolve(
         .collect::<Result<_, _>>()
         .map_err(|e| Error::gltf(asset, e))?;
     assign_offsets(&mut prepared);
-    let (mesh, groups) = join(&prepared);
-    let topo = Topology::build(&mesh);
+    // Before the join, which moves the primitives' vertices out.
     let contexts: Vec<PrimitiveContext> = input
         .primitives
         .iter()
@@ -106,6 +105,19 @@ pub(super) fn resolve(
             vertex_count: prep.vertex_count(),
         })
         .collect();
+    let (mesh, groups) = join(&mut prepared);
+    if mesh.triangles.len() > crate::topology::MAX_TRIANGLES {
+        return Err(Error::limit(
+            asset,
+            format!(
+                "mesh {} has {} triangles, over the {} one mesh can hold (expected it split into several meshes)",
+                input.mesh,
+                mesh.triangles.len(),
+                crate::topology::MAX_TRIANGLES
+            ),
+        ));
+    }
+    let topo = Topology::build(&mesh);
     let ctx = MeshContext {
         index: input.mesh,
         name: input.name.as_deref(),
@@ -158,17 +170,26 @@ pub fn smooth_mesh(
     } = resolve(input, sharpness, options, asset, &mut report.warnings.0)?;
     report.times.sharpness = lap(&clock, 0.0);
     stop_if_cancelled(options, asset)?;
+    // Only the effective widths are read from here on: the requested h and where each came
+    // from (for `--explain-h`) are freed before the surface, the run's peak, is built.
+    let EdgeParams {
+        effective,
+        h,
+        sources,
+        ..
+    } = params;
+    drop((h, sources));
 
-    let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &params.effective);
+    let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &effective);
     report.warnings.0.extend(
         surface_warnings
             .iter()
             .map(|w| Warning::from_surface(input.mesh, None, w)),
     );
     report.edges = if options.report_figures {
-        EdgeFigures::measure(surface.as_ref(), &topo, &params.effective)
+        EdgeFigures::measure(surface.as_ref(), &topo, &effective)
     } else {
-        EdgeFigures::count(&topo, &params.effective)
+        EdgeFigures::count(&topo, &effective)
     };
     report.times.surface = lap(&clock, report.times.sharpness);
     stop_if_cancelled(options, asset)?;
@@ -185,7 +206,7 @@ pub fn smooth_mesh(
             ),
         ));
     }
-    let mut dense = density.tessellate(&mesh, &topo, &params.effective, surface.as_ref(), &groups);
+    let mut dense = density.tessellate(&mesh, &topo, &effective, surface.as_ref(), &groups);
     report.times.tessellate = tess_start.elapsed().as_secs_f64();
     report.adaptive = density.figures(
         &topo,
@@ -212,14 +233,7 @@ pub fn smooth_mesh(
     let attr_start = Instant::now();
     let mut primitives = Vec::with_capacity(prepared.len());
     let (targets, target_warnings) = morph::targets(
-        &mesh,
-        &topo,
-        &params.effective,
-        &prepared,
-        &groups,
-        &density,
-        options,
-        &remaps,
+        &mesh, &topo, &effective, &prepared, &groups, &density, options, &remaps,
     );
     let target_warnings = target_warnings
         .iter()
@@ -432,14 +446,33 @@ fn repair_normals(
 }
 
 /// The primitives of one mesh as one [`TriMesh`], and each primitive's triangle range in it.
-fn join(prepared: &[Prepared]) -> (TriMesh, Vec<Range<usize>>) {
-    let mut mesh = TriMesh::default();
+fn join(prepared: &mut [Prepared]) -> (TriMesh, Vec<Range<usize>>) {
+    // Positions and normals move into the joined mesh (nothing reads them from the primitives
+    // afterwards): a lone primitive's are taken whole, several are copied into arrays sized
+    // once and freed one by one, so no copy outlives the join.
+    let vertices: usize = prepared.iter().map(|p| p.positions.len()).sum();
+    let triangles: usize = prepared.iter().map(|p| p.triangles.len()).sum();
+    let mut mesh = TriMesh {
+        triangles: Vec::with_capacity(triangles),
+        ..TriMesh::default()
+    };
+    if let [p] = prepared {
+        mesh.positions = std::mem::take(&mut p.positions);
+        mesh.normals = std::mem::take(&mut p.normals);
+    } else {
+        mesh.positions.reserve_exact(vertices);
+        mesh.normals.reserve_exact(vertices);
+    }
     let mut groups = Vec::with_capacity(prepared.len());
     for p in prepared {
-        let offset = mesh.positions.len() as u32;
-        debug_assert_eq!(offset, p.vertex_offset);
-        mesh.positions.extend_from_slice(&p.positions);
-        mesh.normals.extend_from_slice(&p.normals);
+        let offset = p.vertex_offset;
+        if !p.positions.is_empty() || !p.normals.is_empty() {
+            debug_assert_eq!(offset as usize, mesh.positions.len());
+            mesh.positions.append(&mut p.positions);
+            mesh.normals.append(&mut p.normals);
+            p.positions = Vec::new();
+            p.normals = Vec::new();
+        }
         let start = mesh.triangles.len();
         mesh.triangles
             .extend(p.triangles.iter().map(|t| t.map(|v| v + offset)));

@@ -22,9 +22,10 @@ use crate::tessellate::DenseMesh;
 pub struct Prepared {
     /// The primitive's attributes and morph targets, indexed like `positions`.
     pub data: PrimitiveData,
-    /// Positions in f64.
+    /// Positions in f64; the join moves them into the whole mesh (empty after it).
     pub positions: Vec<DVec3>,
-    /// Unit normals in f64 (input, repaired, or generated).
+    /// Unit normals in f64 (input, repaired, or generated); moved out by the join like
+    /// `positions`.
     pub normals: Vec<DVec3>,
     /// Triangles over `positions`.
     pub triangles: Vec<[u32; 3]>,
@@ -115,7 +116,7 @@ impl Prepared {
         }
     }
 
-    /// Vertices after any split.
+    /// Vertices after any split; read it before the join moves the vertices out.
     pub fn vertex_count(&self) -> u32 {
         self.positions.len() as u32
     }

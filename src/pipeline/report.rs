@@ -13,7 +13,7 @@ use crate::continuity::angle_deg;
 use crate::optimize::CacheFigures;
 use crate::surface::blend::map_point;
 use crate::surface::Surface;
-use crate::topology::{EdgeKind, Topology};
+use crate::topology::{EdgeKind, Topology, TriId};
 
 /// Seconds spent per stage. Mesh stages are summed over meshes (which may run in parallel, so
 /// the sum can exceed the wall time).
@@ -121,7 +121,7 @@ impl EdgeFigures {
     /// Counts the edges of `topo` by kind under blend widths `h`, measuring nothing.
     pub fn count(topo: &Topology, h: &[f64]) -> EdgeFigures {
         let mut figures = EdgeFigures::default();
-        for (e, edge) in topo.edges.iter().enumerate() {
+        for (e, edge) in topo.edges().enumerate() {
             figures.add(&kind_count(e, edge.kind, h));
         }
         figures
@@ -132,8 +132,7 @@ impl EdgeFigures {
         let mean = crate::continuity::mean_edge_length(topo).max(f64::MIN_POSITIVE);
         // Edges are measured in parallel; sums and maxima do not depend on the order.
         let (mut figures, jump, gap) = topo
-            .edges
-            .par_iter()
+            .par_edges()
             .enumerate()
             .map(|(e, edge)| {
                 let counts = kind_count(e, edge.kind, h);
@@ -141,8 +140,8 @@ impl EdgeFigures {
                 if edge.kind != EdgeKind::Interior {
                     return (counts, jump, gap);
                 }
-                let (f, k) = (edge.tris[0].0 .0 as usize, edge.tris[0].1 as usize);
-                let Some(n) = topo.neighbours[f][k] else {
+                let (f, k) = edge.tris[0].at();
+                let Some(n) = topo.neighbour(TriId(f as u32), k) else {
                     return (counts, jump, gap);
                 };
                 let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));

@@ -92,8 +92,7 @@ impl MeshEdges {
                 .map(|p: &DVec3| p.as_vec3())
                 .collect(),
             edges: topo
-                .edges
-                .iter()
+                .edges()
                 .enumerate()
                 .map(|(e, edge)| {
                     let class = EdgeClass::of(edge.kind, h.get(e).copied().unwrap_or(0.0));

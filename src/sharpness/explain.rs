@@ -139,8 +139,7 @@ impl fmt::Display for ExplainRow {
 
 /// One row per edge, in edge order.
 pub fn explain_rows(params: &EdgeParams, topo: &Topology) -> Vec<ExplainRow> {
-    topo.edges
-        .iter()
+    topo.edges()
         .zip(params.h.iter().zip(&params.sources))
         .enumerate()
         .map(|(i, (edge, (&h, source)))| ExplainRow {

@@ -36,6 +36,7 @@
 //! are positions, matched against the welded vertices within [`DEFAULT_POSITION_TOLERANCE`]
 //! times the diagonal of the mesh's bounding box, in either order.
 
+mod effective;
 mod entries;
 mod error;
 mod explain;
@@ -48,6 +49,7 @@ mod sidecar;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+pub use effective::{EffectiveH, InvalidH};
 pub use error::{Location, Problem, SharpnessError};
 pub use explain::{explain_rows, ExplainRow, HSource};
 pub use extras::EXTRAS_KEY;
@@ -110,7 +112,7 @@ pub struct EdgeParams {
     /// The h each edge is built with: `h` clamped to √2/4 on interior edges, 0 on boundary,
     /// non-manifold and degenerate ones. Decided once here; the surfaces, the tessellator's
     /// creases, the morph targets and the report all read it.
-    pub effective: Vec<f64>,
+    pub effective: EffectiveH,
     pub sources: Vec<HSource>,
     pub warnings: Vec<SharpnessWarning>,
 }

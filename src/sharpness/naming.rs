@@ -75,8 +75,8 @@ impl<'a> EdgeNamer<'a> {
                     .edge_between(wa, wb)
                     .ok_or_else(|| fail(missing()))?;
                 // The welded edge may exist only through another primitive's triangles.
-                let in_primitive = self.topo.edge(edge).tris.iter().any(|&(t, _)| {
-                    let first = self.mesh.triangles[t.0 as usize][0];
+                let in_primitive = self.topo.edge(edge).tris.iter().any(|u| {
+                    let first = self.mesh.triangles[u.at().0][0];
                     first.wrapping_sub(prim.vertex_offset) < prim.vertex_count
                 });
                 if in_primitive {

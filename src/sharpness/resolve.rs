@@ -3,15 +3,17 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use super::entries::{at, fmt_point, Block, EdgeEntry, Located};
 use super::error::{Location, Problem, SharpnessError};
 use super::explain::HSource;
 use super::extras::{parse_block, Owner};
 use super::naming::EdgeNamer;
 use super::rules::{dihedral_degrees, is_crease, is_hard_edge};
-use super::{mesh_label, AssetSharpness, EdgeParams, MeshContext, SharpnessWarning};
+use super::{mesh_label, AssetSharpness, EdgeParams, EffectiveH, MeshContext, SharpnessWarning};
 use crate::mesh::TriMesh;
-use crate::topology::{EdgeId, EdgeKind, Topology};
+use crate::topology::{Edge, EdgeId, EdgeKind, Topology};
 
 pub(crate) fn resolve(
     asset: &AssetSharpness,
@@ -76,107 +78,105 @@ pub(crate) fn resolve(
         })
         .collect();
     let prim_of_tri = primitive_of_triangle(ctx, mesh);
+    // The crease angle and extras default on the side of triangles outside every primitive.
+    let outside_crease = section
+        .and_then(|b| b.crease_angle.as_ref())
+        .or(mesh_block.as_ref().and_then(|b| b.crease_angle.as_ref()))
+        .or(sidecar_asset.and_then(|b| b.crease_angle.as_ref()));
+    let outside_h = mesh_block
+        .as_ref()
+        .and_then(|b| b.h.as_ref())
+        .map(|h| (h, false));
+    let side_crease = |p: u32| match p {
+        NO_PRIMITIVE => outside_crease,
+        p => crease_of_prim[p as usize],
+    };
+    let side_h = |p: u32| match p {
+        NO_PRIMITIVE => outside_h,
+        p => extras_h_of_prim[p as usize],
+    };
 
-    let mut h = Vec::with_capacity(topo.edges.len());
-    let mut effective = Vec::with_capacity(topo.edges.len());
-    let mut sources = Vec::with_capacity(topo.edges.len());
-    for (e, edge) in topo.edges.iter().enumerate() {
-        let id = EdgeId(e as u32);
-        // The primitives on the edge's sides; `None` for triangles outside every primitive.
-        let mut sides: Vec<Option<usize>> = edge
-            .tris
-            .iter()
-            .map(|&(t, _)| prim_of_tri[t.0 as usize])
-            .collect();
-        sides.sort_unstable();
-        sides.dedup();
-        let side_crease = |p: &Option<usize>| match p {
-            Some(p) => crease_of_prim[*p],
-            None => section
-                .and_then(|b| b.crease_angle.as_ref())
-                .or(mesh_block.as_ref().and_then(|b| b.crease_angle.as_ref()))
-                .or(sidecar_asset.and_then(|b| b.crease_angle.as_ref())),
-        };
-        let side_h = |p: &Option<usize>| match p {
-            Some(p) => extras_h_of_prim[*p],
-            None => mesh_block
-                .as_ref()
-                .and_then(|b| b.h.as_ref())
-                .map(|h| (h, false)),
-        };
-
-        let (value, source) = if let Some(x) = sidecar_edges.get(&id) {
-            (x.value, HSource::SidecarEdge(x.at.clone()))
-        } else if let Some(x) = prim_edges.get(&id) {
-            (x.value, HSource::PrimitiveExtrasEdge(x.at.clone()))
-        } else if let Some(x) = mesh_edges.get(&id) {
-            (x.value, HSource::MeshExtrasEdge(x.at.clone()))
-        } else if let Some(rule) = crease_rule(
-            edge,
-            topo,
-            sides.iter().map(side_crease),
-            asset.defaults.crease_angle,
-        ) {
-            (0.0, rule)
-        } else if asset.defaults.keep_hard_edges && is_hard_edge(edge) {
-            (0.0, HSource::HardEdge)
-        } else if let Some(x) = section.and_then(|b| b.h.as_ref()) {
-            (x.value, HSource::SidecarMeshDefault(x.at.clone()))
-        } else if let Some((x, on_prim)) = sides
-            .iter()
-            .filter_map(side_h)
-            .min_by(|a, b| a.0.value.total_cmp(&b.0.value))
-        {
-            let at = x.at.clone();
-            let source = if on_prim {
-                HSource::PrimitiveExtrasDefault(at)
+    // Edges are independent: resolved in parallel, collected in edge order.
+    let (h, (effective, sources)): (Vec<f64>, (Vec<f64>, Vec<HSource>)) = topo
+        .par_edges()
+        .enumerate()
+        .map(|(e, edge)| {
+            let id = EdgeId(e as u32);
+            // The primitives on the edge's sides, read straight from its uses: the sharpest
+            // value wins, ties going to the lowest primitive (triangles outside every
+            // primitive first), whatever the order of the uses.
+            let sides = || edge.tris.iter().map(|u| prim_of_tri[u.at().0]);
+            let (value, source) = if let Some(x) = sidecar_edges.get(&id) {
+                (x.value, HSource::SidecarEdge(x.at.clone()))
+            } else if let Some(x) = prim_edges.get(&id) {
+                (x.value, HSource::PrimitiveExtrasEdge(x.at.clone()))
+            } else if let Some(x) = mesh_edges.get(&id) {
+                (x.value, HSource::MeshExtrasEdge(x.at.clone()))
+            } else if let Some(rule) = crease_rule(
+                &edge,
+                topo,
+                sharpest(sides(), |p| {
+                    side_crease(p).map_or(asset.defaults.crease_angle, |a| a.value)
+                })
+                .and_then(side_crease),
+                asset.defaults.crease_angle,
+            ) {
+                (0.0, rule)
+            } else if asset.defaults.keep_hard_edges && is_hard_edge(&edge) {
+                (0.0, HSource::HardEdge)
+            } else if let Some(x) = section.and_then(|b| b.h.as_ref()) {
+                (x.value, HSource::SidecarMeshDefault(x.at.clone()))
+            } else if let Some((x, on_prim)) =
+                sharpest(sides().filter(|&p| side_h(p).is_some()), |p| {
+                    side_h(p).map_or(f64::INFINITY, |x| x.0.value)
+                })
+                .and_then(side_h)
+            {
+                let at = x.at.clone();
+                let source = if on_prim {
+                    HSource::PrimitiveExtrasDefault(at)
+                } else {
+                    HSource::MeshExtrasDefault(at)
+                };
+                (x.value, source)
+            } else if let Some(x) = sidecar_asset.and_then(|b| b.h.as_ref()) {
+                (x.value, HSource::SidecarAssetDefault(x.at.clone()))
             } else {
-                HSource::MeshExtrasDefault(at)
+                (asset.defaults.h, HSource::Options)
             };
-            (x.value, source)
-        } else if let Some(x) = sidecar_asset.and_then(|b| b.h.as_ref()) {
-            (x.value, HSource::SidecarAssetDefault(x.at.clone()))
-        } else {
-            (asset.defaults.h, HSource::Options)
-        };
-        effective.push(effective_h(edge.kind, value));
-        h.push(value);
-        sources.push(source);
-    }
+            (value, (EffectiveH::of_edge(edge.kind, value), source))
+        })
+        .unzip();
     Ok(EdgeParams {
         h,
-        effective,
+        effective: EffectiveH::from_rule(effective),
         sources,
         warnings,
     })
 }
 
-/// The h an edge is built with, decided here once for every later stage: the resolved value
-/// (already in range, the printed bound clamped to √2/4) on interior edges, 0 on boundary,
-/// non-manifold and degenerate edges, which the surface never blends. An explicit entry asking
-/// for more on such an edge is warned about where it is read ([`Explicit::note`]); a default
-/// that merely covers it is not, so an open mesh at default settings gives no warning.
-fn effective_h(kind: EdgeKind, value: f64) -> f64 {
-    if kind == EdgeKind::Interior {
-        crate::options::clamp_h(value)
-    } else {
-        0.0
-    }
+/// The side (a primitive, or [`NO_PRIMITIVE`]) with the smallest `value`, ties going to the
+/// smallest side with [`NO_PRIMITIVE`] first: the order a sorted, deduplicated list of sides
+/// gives, without building one per edge.
+fn sharpest(sides: impl Iterator<Item = u32>, value: impl Fn(u32) -> f64) -> Option<u32> {
+    let rank = |p: u32| p.wrapping_add(1);
+    sides
+        .map(|p| (value(p), p))
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(rank(a.1).cmp(&rank(b.1))))
+        .map(|(_, p)| p)
 }
 
-/// The crease rule for one edge: the sharpest crease angle over its sides (the options' when no
-/// side sets one), and h = 0 if the faces meet at more than that.
-fn crease_rule<'a>(
-    edge: &crate::topology::Edge,
+/// The crease rule for one edge: the sharpest crease angle over its sides (`side_angle`, the
+/// options' when that side sets none), and h = 0 if the faces meet at more than that.
+fn crease_rule(
+    edge: &Edge<'_>,
     topo: &Topology,
-    side_angles: impl Iterator<Item = Option<&'a Located<f64>>>,
+    side_angle: Option<&Located<f64>>,
     default_angle: f64,
 ) -> Option<HSource> {
     let dihedral = dihedral_degrees(edge, topo)?;
-    let (crease_angle, set_by) = side_angles
-        .map(|a| a.map_or((default_angle, None), |a| (a.value, Some(a.at.clone()))))
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .unwrap_or((default_angle, None));
+    let (crease_angle, set_by) =
+        side_angle.map_or((default_angle, None), |a| (a.value, Some(a.at.clone())));
     is_crease(dihedral, crease_angle).then_some(HSource::Crease {
         dihedral,
         crease_angle,
@@ -246,18 +246,28 @@ impl Explicit<'_, '_> {
     }
 }
 
-/// Which entry of `ctx.primitives` each triangle came from, by its first corner's vertex range.
-fn primitive_of_triangle(ctx: &MeshContext<'_>, mesh: &TriMesh) -> Vec<Option<usize>> {
+/// Marks a triangle outside every primitive in [`primitive_of_triangle`].
+const NO_PRIMITIVE: u32 = u32::MAX;
+
+/// Which entry of `ctx.primitives` each triangle came from, by its first corner's vertex range;
+/// [`NO_PRIMITIVE`] for none (4 bytes a triangle where `Option<usize>` took 16).
+fn primitive_of_triangle(ctx: &MeshContext<'_>, mesh: &TriMesh) -> Vec<u32> {
     let mut by_offset: Vec<usize> = (0..ctx.primitives.len()).collect();
     by_offset.sort_by_key(|&p| ctx.primitives[p].vertex_offset);
     mesh.triangles
-        .iter()
+        .par_iter()
         .map(|t| {
             let v = t[0];
             let after = by_offset.partition_point(|&p| ctx.primitives[p].vertex_offset <= v);
-            let p = *by_offset.get(after.checked_sub(1)?)?;
+            let Some(&p) = after.checked_sub(1).and_then(|i| by_offset.get(i)) else {
+                return NO_PRIMITIVE;
+            };
             let prim = &ctx.primitives[p];
-            (v - prim.vertex_offset < prim.vertex_count).then_some(p)
+            if v - prim.vertex_offset < prim.vertex_count {
+                p as u32
+            } else {
+                NO_PRIMITIVE
+            }
         })
         .collect()
 }

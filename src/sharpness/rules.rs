@@ -17,22 +17,20 @@ pub const CREASE_SLACK_DEGREES: f64 = 1e-6;
 /// The normals are oriented consistently before comparing: if both triangles run the edge in
 /// the same direction, their windings disagree and one normal is flipped, so a mesh with mixed
 /// winding gets the same creases as a clean one.
-pub fn dihedral_degrees(edge: &Edge, topo: &Topology) -> Option<f64> {
+pub fn dihedral_degrees(edge: &Edge<'_>, topo: &Topology) -> Option<f64> {
     if edge.kind != EdgeKind::Interior {
         return None;
     }
-    let [(t0, k0), (t1, k1)] = edge.tris.as_slice() else {
-        return None;
-    };
+    let [(t0, k0), (t1, k1)] = [edge.tris.first()?.at(), edge.tris.last()?.at()];
     let face = |t: usize| {
         let [a, b, c] = topo.tri_verts[t].map(|v| topo.welded_positions[v.0 as usize]);
         (b - a).cross(c - a)
     };
     // Edge k of a triangle runs from corner k + 1 to corner k + 2.
-    let start = |t: usize, k: u8| topo.tri_verts[t][(k as usize + 1) % 3];
-    let n0 = face(t0.0 as usize);
-    let mut n1 = face(t1.0 as usize);
-    if start(t0.0 as usize, *k0) == start(t1.0 as usize, *k1) {
+    let start = |t: usize, k: usize| topo.tri_verts[t][(k + 1) % 3];
+    let n0 = face(t0);
+    let mut n1 = face(t1);
+    if start(t0, k0) == start(t1, k1) {
         n1 = -n1;
     }
     Some(angle_degrees(n0, n1))
@@ -45,7 +43,7 @@ pub fn is_crease(dihedral: f64, crease_angle: f64) -> bool {
 
 /// Whether the input marks the edge hard: the triangles on its two sides carry different
 /// normals at one of its ends.
-pub fn is_hard_edge(edge: &Edge) -> bool {
+pub fn is_hard_edge(edge: &Edge<'_>) -> bool {
     edge.split_normals
 }
 

@@ -12,9 +12,10 @@ use super::blend::neighbour_map;
 use super::nets::Nets;
 use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights};
 use super::pn::{compose, Net, B111, NEAR};
-use super::{LatticePart, Profile, Surface, SurfacePoint, H_MAX};
+use super::{LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
-use crate::topology::{Edge, EdgeKind, Topology, Warning};
+use crate::sharpness::EffectiveH;
+use crate::topology::{Edge, EdgeId, Topology, TriId, Warning};
 
 /// A control net by coordinate, `[x, y, z][control point]`: the layout the per-point sums of
 /// [`accumulate`] read, one coordinate of one control point at a time.
@@ -81,7 +82,7 @@ pub struct G2Surface {
     patches: Vec<Patch>,
     vertices: Vec<CornerVertex>,
     profile: Profile,
-    h_edge: Vec<f64>,
+    h_edge: EffectiveH,
     warnings: Vec<Warning>,
     patterns: PatternCache,
 }
@@ -113,7 +114,9 @@ impl G2Surface {
     ) -> Self {
         super::assert_belong_together(mesh, topo, h_per_edge);
 
-        let (h_edge, warnings) = effective_widths(topo, h_per_edge);
+        // The one rule for which edges blend and how wide (widths the pipeline resolved pass
+        // through it unchanged, and without warnings).
+        let (h_edge, warnings) = EffectiveH::from_requested(topo, h_per_edge);
         let vertices: Vec<CornerVertex> = mesh
             .positions
             .par_iter()
@@ -132,7 +135,9 @@ impl G2Surface {
                 let edges = topo.tri_edges[t].map(|e| e.0);
                 let across = std::array::from_fn(|k| {
                     if h_edge[edges[k] as usize] > 0.0 {
-                        let n = topo.neighbours[t][k].expect("blended edges are interior");
+                        let n = topo
+                            .neighbour(TriId(t as u32), k)
+                            .expect("blended edges are interior");
                         Across {
                             tri: n.tri.0,
                             slots: n.slots,
@@ -460,7 +465,7 @@ impl PnSurface {
     /// PN triangles over `mesh` on nets made by the rule `nets` ([`Nets::Paper`]: Vlachos et
     /// al. as published).
     pub fn with_nets(mesh: &TriMesh, topo: &Topology, nets: Nets) -> Self {
-        let zero = vec![0.0; topo.edges.len()];
+        let zero = vec![0.0; topo.edge_count()];
         PnSurface(G2Surface::with_nets(
             mesh,
             topo,
@@ -491,40 +496,6 @@ impl Surface for PnSurface {
     }
 }
 
-/// Clamped widths per edge (0 for edges that cannot blend) and one warning per kind of edge
-/// that was asked to blend but cannot.
-fn effective_widths(topo: &Topology, h: &[f64]) -> (Vec<f64>, Vec<Warning>) {
-    let mut ignored: Vec<(EdgeKind, usize, usize)> = Vec::new();
-    let widths = topo
-        .edges
-        .iter()
-        .zip(h)
-        .enumerate()
-        .map(|(e, (edge, &h))| {
-            let h = if h > 0.0 { h.min(H_MAX) } else { 0.0 };
-            if edge.kind == EdgeKind::Interior {
-                return h;
-            }
-            if h > 0.0 {
-                match ignored.iter_mut().find(|(k, _, _)| *k == edge.kind) {
-                    Some(entry) => entry.1 += 1,
-                    None => ignored.push((edge.kind, 1, e)),
-                }
-            }
-            0.0
-        })
-        .collect();
-    let warnings = ignored
-        .into_iter()
-        .map(|(kind, edges, first)| Warning::BlendIgnored {
-            kind,
-            edges,
-            first: crate::topology::EdgeId(first as u32),
-        })
-        .collect();
-    (widths, warnings)
-}
-
 /// Makes every triangle along an unblended edge use one boundary curve: if their inner edge
 /// control points differ (split normals), each gets the average, oriented along the edge
 /// (PN-AEN); `b111` is then recomputed from the new edge points by the centre rule of `rule`
@@ -547,9 +518,8 @@ fn share_unblended_edge_curves(
     };
     let uses = |edge| edge_uses(topo, edge);
     let averaged: Vec<(usize, [DVec3; 2])> = topo
-        .edges
-        .par_iter()
-        .zip(h_edge)
+        .par_edges()
+        .zip(h_edge.par_iter())
         .enumerate()
         .filter_map(|(e, (edge, &h))| {
             if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
@@ -574,7 +544,7 @@ fn share_unblended_edge_curves(
     }
     let mut touched = Vec::new();
     for (e, avg) in averaged {
-        for (t, s) in uses(&topo.edges[e]) {
+        for (t, s) in uses(topo.edge(EdgeId(e as u32))) {
             for (slot, value) in s.into_iter().zip(avg) {
                 let inner = &mut patches[t].inner;
                 [inner[0][slot - 3], inner[1][slot - 3], inner[2][slot - 3]] = value.to_array();
@@ -597,10 +567,10 @@ fn share_unblended_edge_curves(
 /// control points, in the edge's use order.
 fn edge_uses<'a>(
     topo: &'a Topology,
-    edge: &'a Edge,
+    edge: Edge<'a>,
 ) -> impl Iterator<Item = (usize, [usize; 2])> + 'a {
-    edge.tris.as_slice().iter().map(move |&(t, k)| {
-        let (k, t) = (k as usize, t.0 as usize);
+    edge.tris.iter().map(move |u| {
+        let (t, k) = u.at();
         let (i, j) = ((k + 1) % 3, (k + 2) % 3);
         let s = if topo.tri_verts[t][i] == edge.verts[0] {
             [NEAR[i][j], NEAR[j][i]]

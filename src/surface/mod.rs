@@ -66,7 +66,7 @@ pub const H_MAX: f64 = std::f64::consts::SQRT_2 / 4.0;
 /// # Panics
 /// If `topo` was not built from `mesh`, or `h_per_edge` is not one value per welded edge.
 pub(crate) fn assert_belong_together(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64]) {
-    assert_eq!(h_per_edge.len(), topo.edges.len(), "one h per welded edge");
+    assert_eq!(h_per_edge.len(), topo.edge_count(), "one h per welded edge");
     assert_eq!(
         topo.tri_verts.len(),
         mesh.triangles.len(),

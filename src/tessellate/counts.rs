@@ -89,7 +89,7 @@ impl ChordErrors {
                 },
             )
             .collect();
-        let mut edges = vec![0.0f64; topo.edges.len()];
+        let mut edges = vec![0.0f64; topo.edge_count()];
         for (e, c) in edges.iter_mut().enumerate() {
             // The evaluator's side: the one whose samples are written.
             if let Some((tri, k)) = evaluator(topo, e) {
@@ -239,7 +239,7 @@ impl SegmentCounts {
     /// Every edge and every interior at `level`: the uniform tessellation.
     pub fn uniform(topo: &Topology, level: u32) -> SegmentCounts {
         SegmentCounts {
-            edges: vec![level; topo.edges.len()],
+            edges: vec![level; topo.edge_count()],
             inner: vec![level; topo.tri_edges.len()],
         }
     }

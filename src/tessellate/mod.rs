@@ -190,12 +190,11 @@ struct EdgeSamples {
 
 /// The triangle that evaluates the samples of welded edge `e` for everyone, and the corner its
 /// side of the edge is opposite: the edge's lowest-numbered triangle, its first use (the uses
-/// are kept in (triangle, corner) order, see [`crate::topology::Edge::tris`]). Reading the first
+/// are kept in (triangle, corner) order, see [`crate::topology::Topology::edge_uses`]). Reading the first
 /// use instead of searching them all keeps this constant time: it is asked once per triangle
 /// side, so a search made a book of many triangles on one edge quadratic.
 fn evaluator(topo: &Topology, e: usize) -> Option<(usize, usize)> {
-    let &(tri, k) = topo.edges[e].tris.first()?;
-    Some((tri.0 as usize, k as usize))
+    Some(topo.edge_uses(EdgeId(e as u32)).first()?.at())
 }
 
 /// Evaluates the samples of every welded edge once, from its [`evaluator`].
@@ -207,8 +206,8 @@ fn shared_edge_samples(
 ) -> EdgeSamples {
     let per_edge = (n - 1) as usize;
     let mut out = EdgeSamples {
-        positions: vec![[0.0f32; 3]; topo.edges.len() * per_edge],
-        normals: vec![[0.0f32; 3]; topo.edges.len() * per_edge],
+        positions: vec![[0.0f32; 3]; topo.edge_count() * per_edge],
+        normals: vec![[0.0f32; 3]; topo.edge_count() * per_edge],
     };
     if per_edge == 0 || mesh.triangles.is_empty() {
         return out;
@@ -239,13 +238,12 @@ fn shared_edge_samples(
 /// Whether the edge opposite corner `k` of `tri`, walked from corner `k+1` to corner `k+2`,
 /// runs in its welded edge's canonical direction.
 fn canonical_forward(topo: &Topology, tri: usize, k: usize) -> bool {
-    let edge = &topo.edges[topo.tri_edges[tri][k].0 as usize];
     let from = topo.tri_verts[tri][(k + 1) % 3];
-    from == edge.verts[0]
+    from == topo.edge_verts(topo.tri_edges[tri][k])[0]
 }
 
 fn is_crease(topo: &Topology, h: &[f64], e: EdgeId) -> bool {
-    h.get(e.0 as usize).is_some_and(|&v| v == 0.0) && topo.edges[e.0 as usize].tris.len() >= 2
+    h.get(e.0 as usize).is_some_and(|&v| v == 0.0) && topo.edge_uses(e).len() >= 2
 }
 
 /// Position and normal of corner `c` of `tri` as written: the vertex's own position, not its

@@ -87,10 +87,8 @@ fn edge_between(p: &[[f32; 3]], i: &[u32], a: u32, b: u32) -> usize {
     let topo = topology(p, i);
     let mut ends = [a, b].map(|v| topo.welded_of_vertex[v as usize]);
     ends.sort();
-    topo.edges
-        .iter()
-        .position(|e| e.verts == ends)
-        .expect("the edge")
+    let at = topo.edges().position(|e| e.verts == ends);
+    at.expect("the edge")
 }
 
 #[test]

@@ -92,8 +92,7 @@ fn mixed_h_gives_g1_on_smooth_edges_and_creases_elsewhere() {
     let topo = Topology::build(&mesh);
     let mut rng = Lcg(17);
     let h: Vec<f64> = topo
-        .edges
-        .iter()
+        .edges()
         .map(|_| if rng.next() < 0.3 { 0.0 } else { 0.2 })
         .collect();
     let l = continuity::mean_edge_length(&topo);
@@ -132,8 +131,7 @@ fn boundary_edges_asked_to_blend_are_reported_in_every_scheme() {
     let mesh = height_field(6);
     let topo = Topology::build(&mesh);
     let boundary = topo
-        .edges
-        .iter()
+        .edges()
         .filter(|e| e.kind == EdgeKind::Boundary)
         .count();
     for scheme in [Scheme::G2, Scheme::Hybrid, Scheme::Coons] {
@@ -155,8 +153,7 @@ fn a_folded_edge_with_no_projection_plane_becomes_a_reported_crease() {
     let h = h_all(&topo, 0.2);
     let s = HybridSurface::new(&mesh, &topo, &h);
     let fold = topo
-        .edges
-        .iter()
+        .edges()
         .position(|e| e.kind == EdgeKind::Interior)
         .expect("the fold");
     assert!(s.warnings().contains(&Warning::NoProjectionPlane {

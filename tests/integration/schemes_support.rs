@@ -7,7 +7,7 @@ use g2tess::continuity::angle_deg;
 use g2tess::mesh::TriMesh;
 use g2tess::surface::blend::map_point;
 use g2tess::surface::{lattice_bary, Surface};
-use g2tess::topology::{EdgeKind, Topology};
+use g2tess::topology::{EdgeKind, Topology, TriId};
 use glam::DVec3;
 
 /// An exact surface that a test mesh samples.
@@ -57,12 +57,12 @@ pub fn edge_jumps(
     margin: f64,
 ) -> Vec<(usize, f64, f64)> {
     let mut out = Vec::new();
-    for (e, edge) in topo.edges.iter().enumerate() {
+    for (e, edge) in topo.edges().enumerate() {
         if edge.kind != EdgeKind::Interior {
             continue;
         }
-        let (f, k) = (edge.tris[0].0 .0 as usize, edge.tris[0].1 as usize);
-        let n = topo.neighbours[f][k].expect("interior");
+        let (f, k) = edge.tris[0].at();
+        let n = topo.neighbour(TriId(f as u32), k).expect("interior");
         let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));
         let (mut gap, mut angle) = (0.0f64, 0.0f64);
         for m in 0..per_edge {

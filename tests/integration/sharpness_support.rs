@@ -222,8 +222,7 @@ impl Resolved {
     /// h of every edge whose faces meet at about `dihedral` degrees.
     pub fn h_at_dihedral(&self, dihedral: f64) -> Vec<f64> {
         self.topo
-            .edges
-            .iter()
+            .edges()
             .zip(&self.params.h)
             .filter(|(e, _)| {
                 g2tess::sharpness::dihedral_degrees(e, &self.topo)

@@ -285,7 +285,7 @@ pub fn reorder(mesh: &TriMesh, reversed: f64, seed: u64) -> Reordered {
 
 /// The same `h` on every edge.
 pub fn h_all(topo: &Topology, h: f64) -> Vec<f64> {
-    vec![h; topo.edges.len()]
+    vec![h; topo.edge_count()]
 }
 
 /// Mean edge length of a mesh.

@@ -72,8 +72,7 @@ fn split_normals_stay_watertight_at_h_zero_and_close_for_h_above() {
     let mesh = split_normals(&bumpy_sphere(), 0.5);
     let topo = Topology::build(&mesh);
     assert!(topo
-        .edges
-        .iter()
+        .edges()
         .all(|e| e.kind == EdgeKind::Interior && e.split_normals));
     // h = 0: the edge curves are averaged (PN-AEN); positions agree, normals do not.
     let r = continuity::measure(&PnSurface::new(&mesh, &topo), &topo, &Sampling::default());
@@ -98,8 +97,8 @@ fn switch_line_jump(mesh: &g2tess::mesh::TriMesh, h: f64, profile: Profile, eps:
     let s = G2Surface::new(mesh, &topo, &h_all(&topo, h), profile);
     let l = continuity::mean_edge_length(&topo);
     let mut worst: f64 = 0.0;
-    for e in topo.edges.iter().filter(|e| e.kind == EdgeKind::Interior) {
-        let (t, k) = (e.tris[0].0 .0 as usize, e.tris[0].1 as usize);
+    for e in topo.edges().filter(|e| e.kind == EdgeKind::Interior) {
+        let (t, k) = e.tris[0].at();
         let (a, b) = ((k + 2) % 3, (k + 1) % 3);
         for sw in Profile::switch_points(h) {
             // s runs from corner b (s = 0) to corner a (s = √2); r(sw) is the same for both

@@ -60,7 +60,7 @@ fn flat_mesh_with_equal_normals_stays_exactly_flat() {
     let mesh = flat_grid(4);
     let topo = Topology::build(&mesh);
     let mut rng = Lcg(5);
-    let h: Vec<f64> = topo.edges.iter().map(|_| rng.next() * H_MAX).collect();
+    let h: Vec<f64> = topo.edges().map(|_| rng.next() * H_MAX).collect();
     for profile in [Profile::Paper, Profile::C2] {
         let s = G2Surface::new(&mesh, &topo, &h, profile);
         for t in 0..mesh.triangles.len() {
@@ -102,8 +102,7 @@ fn lattice_evaluation_equals_point_evaluation() {
     let topo = Topology::build(&mesh);
     let mut rng = Lcg(11);
     let h: Vec<f64> = topo
-        .edges
-        .iter()
+        .edges()
         .map(|_| (rng.next() * 4.0).floor() * 0.1)
         .collect();
     let s = G2Surface::new(&mesh, &topo, &h, Profile::C2);
@@ -139,7 +138,7 @@ fn reordering_corners_or_flipping_triangles_does_not_move_the_surface() {
         for (reversed, seed) in [(0.0, 1), (0.3, 2)] {
             let re = reorder(&mesh, reversed, seed);
             let topo2 = Topology::build(&re.mesh);
-            assert_eq!(topo2.edges.len(), topo.edges.len());
+            assert_eq!(topo2.edge_count(), topo.edge_count());
             // The same h per welded edge: look each edge up by its end positions.
             let h_of = |topo: &Topology, e: &g2tess::topology::Edge| {
                 let [a, b] = e.verts.map(|v| topo.welded_positions[v.0 as usize]);
@@ -148,8 +147,8 @@ fn reordering_corners_or_flipping_triangles_does_not_move_the_surface() {
                     .abs()
                     * H_MAX
             };
-            let h1: Vec<f64> = topo.edges.iter().map(|e| h_of(&topo, e)).collect();
-            let h2: Vec<f64> = topo2.edges.iter().map(|e| h_of(&topo2, e)).collect();
+            let h1: Vec<f64> = topo.edges().map(|e| h_of(&topo, &e)).collect();
+            let h2: Vec<f64> = topo2.edges().map(|e| h_of(&topo2, &e)).collect();
             for profile in [Profile::Paper, Profile::C2] {
                 let s1 = G2Surface::new(&mesh, &topo, &h1, profile);
                 let s2 = G2Surface::new(&re.mesh, &topo2, &h2, profile);
@@ -175,11 +174,10 @@ fn h_is_clamped_and_unblendable_edges_are_reported() {
     let topo = Topology::build(&mesh);
     let s = G2Surface::new(&mesh, &topo, &h_all(&topo, 5.0), Profile::C2);
     let boundary = topo
-        .edges
-        .iter()
+        .edges()
         .filter(|e| e.kind == g2tess::topology::EdgeKind::Boundary)
         .count();
-    for (e, &h) in topo.edges.iter().zip(s.effective_h()) {
+    for (e, &h) in topo.edges().zip(s.effective_h()) {
         let want = if e.kind == g2tess::topology::EdgeKind::Interior {
             H_MAX
         } else {

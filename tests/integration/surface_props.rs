@@ -47,7 +47,7 @@ fn reorder(mesh: &mut TriMesh, rot: &[usize], flip: &[bool]) {
 /// interior edge, and corners exact.
 fn check(mesh: &TriMesh, h: f64, profile: Profile) -> Result<(), TestCaseError> {
     let topo = Topology::build(mesh);
-    let s = G2Surface::new(mesh, &topo, &vec![h; topo.edges.len()], profile);
+    let s = G2Surface::new(mesh, &topo, &vec![h; topo.edge_count()], profile);
     // The blend reaches r ≤ h from the edge: eps must be well inside that to see G2.
     let sampling = Sampling {
         eps: vec![h * 1e-2, h * 1e-3, h * 1e-4],
@@ -130,7 +130,7 @@ proptest! {
 
         // G1 at the vertex: near the centre every triangle's normal approaches the vertex normal.
         let topo = Topology::build(&mesh);
-        let s = G2Surface::new(&mesh, &topo, &vec![h; topo.edges.len()], profile);
+        let s = G2Surface::new(&mesh, &topo, &vec![h; topo.edge_count()], profile);
         for (t, tri) in mesh.triangles.iter().enumerate() {
             let c = tri.iter().position(|&v| v == 0).expect("fan triangles use the centre");
             let mut l = [0.5e-7; 3];

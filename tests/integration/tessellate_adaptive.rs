@@ -193,8 +193,7 @@ fn watertight_at_every_tolerance() {
             // Open input edges, each cut into its own count of segments; nothing else open.
             let expected: u32 = r
                 .topo
-                .edges
-                .iter()
+                .edges()
                 .zip(&r.counts.edges)
                 .filter(|(e, _)| e.tris.len() == 1)
                 .map(|(_, &c)| c)

@@ -65,7 +65,7 @@ use super::scheme::creases::{own_nets, smooth_edges, Corners};
 use super::scheme::{SchemeParams, Warning};
 use super::{blend, lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
-use crate::topology::Topology;
+use crate::topology::{Topology, TriId};
 use patch::Definition2;
 use weights::Weights;
 
@@ -343,7 +343,9 @@ fn pn_average(mesh: &TriMesh, topo: &Topology, h: &[f64]) -> Built {
                 if !smooth[topo.tri_edges[t][k].0 as usize] {
                     return own[t];
                 }
-                let n = topo.neighbours[t][k].expect("smooth edges are interior");
+                let n = topo
+                    .neighbour(TriId(t as u32), k)
+                    .expect("smooth edges are interior");
                 let cols = blend::neighbour_map(k, n.slots.map(usize::from));
                 let other = compose(&own[n.tri.0 as usize], cols);
                 std::array::from_fn(|m| 0.5 * (own[t][m] + other[m]))

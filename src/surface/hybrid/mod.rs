@@ -48,7 +48,7 @@ use super::scheme::creases::{edge_end_normal, own_nets, smooth_edges, Corners};
 use super::scheme::Warning;
 use super::{lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
-use crate::topology::{EdgeId, Topology};
+use crate::topology::{EdgeId, Topology, TriId};
 use foley_opitz::{apex_barycentrics, interior_point, neighbour_interior, Labelled};
 use patch::{BoundaryBlend, Weights, TERMS};
 
@@ -89,9 +89,9 @@ impl EdgeNets {
             .collect();
         let (mut smooth, mut warnings) = smooth_edges(topo, h_per_edge);
 
-        let mut planes = vec![DVec3::ZERO; topo.edges.len()];
+        let mut planes = vec![DVec3::ZERO; topo.edge_count()];
         let mut failed: Option<(usize, usize)> = None;
-        for e in 0..topo.edges.len() {
+        for e in 0..topo.edge_count() {
             if !smooth[e] {
                 continue;
             }
@@ -114,7 +114,7 @@ impl EdgeNets {
 
         let own = own_nets(&corners, topo, &smooth);
         let mut nets: Vec<[Net; 3]> = own.iter().map(|n| [*n; 3]).collect();
-        for e in (0..topo.edges.len()).filter(|&e| smooth[e]) {
+        for e in (0..topo.edge_count()).filter(|&e| smooth[e]) {
             let edge = EdgeFrame::new(&corners, topo, e);
             let (net_f, net_g) = edge.nets(&corners, planes[e], reading);
             nets[edge.f][edge.kf] = net_f;
@@ -145,9 +145,10 @@ struct EdgeFrame {
 
 impl EdgeFrame {
     fn new(corners: &[Corners], topo: &Topology, e: usize) -> EdgeFrame {
-        let (f, kf) = topo.edges[e].tris[0];
-        let (f, kf) = (f.0 as usize, kf as usize);
-        let n = topo.neighbours[f][kf].expect("smooth edges are interior");
+        let (f, kf) = topo.edge_uses(EdgeId(e as u32))[0].at();
+        let n = topo
+            .neighbour(TriId(f as u32), kf)
+            .expect("smooth edges are interior");
         let (g, slots) = (n.tri.0 as usize, n.slots.map(usize::from));
         let (i, j) = ((kf + 1) % 3, (kf + 2) % 3);
         let na = edge_end_normal(corners, f, i, g, slots[0]);

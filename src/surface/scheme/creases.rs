@@ -8,9 +8,10 @@ use glam::DVec3;
 
 use super::Warning;
 use crate::mesh::TriMesh;
+use crate::sharpness::EffectiveH;
 use crate::surface::pn::{central_point, pn_net, Net, B111, NEAR};
 use crate::surface::SurfacePoint;
-use crate::topology::{self, EdgeId, EdgeKind, Topology};
+use crate::topology::Topology;
 
 /// Input corner positions and normalized input normals of one triangle (a zero normal falls back
 /// to the face normal, a degenerate face to +z).
@@ -62,41 +63,16 @@ impl Corners {
     }
 }
 
-/// Which edges are smooth: interior edges with `h > 0` (NaN counts as 0). Non-interior edges
-/// asked for `h > 0` are creases, reported once per kind as in the G² scheme.
+/// Which edges are smooth: those the one rule ([`EffectiveH::from_requested`]) gives a width
+/// above 0, that is interior edges with `h > 0` (NaN counts as 0). Non-interior edges asked for
+/// `h > 0` are creases, reported once per kind as in the G² scheme.
 ///
 /// # Panics
 /// If `h` does not have one entry per edge of `topo`.
 pub fn smooth_edges(topo: &Topology, h: &[f64]) -> (Vec<bool>, Vec<Warning>) {
-    assert_eq!(h.len(), topo.edges.len(), "one h per welded edge");
-    let mut ignored: Vec<(EdgeKind, usize, usize)> = Vec::new();
-    let smooth = topo
-        .edges
-        .iter()
-        .zip(h)
-        .enumerate()
-        .map(|(e, (edge, &h))| {
-            let wanted = h > 0.0;
-            if wanted && edge.kind != EdgeKind::Interior {
-                match ignored.iter_mut().find(|(k, _, _)| *k == edge.kind) {
-                    Some(entry) => entry.1 += 1,
-                    None => ignored.push((edge.kind, 1, e)),
-                }
-            }
-            wanted && edge.kind == EdgeKind::Interior
-        })
-        .collect();
-    let warnings = ignored
-        .into_iter()
-        .map(|(kind, edges, first)| {
-            Warning::Edges(topology::Warning::BlendIgnored {
-                kind,
-                edges,
-                first: EdgeId(first as u32),
-            })
-        })
-        .collect();
-    (smooth, warnings)
+    let (effective, ignored) = EffectiveH::from_requested(topo, h);
+    let smooth = effective.iter().map(|&h| h > 0.0).collect();
+    (smooth, ignored.into_iter().map(Warning::Edges).collect())
 }
 
 /// Each triangle's PN net (seed 000 Eq. 2, all six edge points in `E`), with one boundary curve
@@ -113,7 +89,7 @@ pub fn own_nets(corners: &[Corners], topo: &Topology, smooth: &[bool]) -> Vec<Ne
         .map(|c| pn_net(c.position, c.normal))
         .collect();
     let mut touched = vec![false; nets.len()];
-    for (edge, &smooth) in topo.edges.iter().zip(smooth) {
+    for (edge, &smooth) in topo.edges().zip(smooth) {
         if smooth || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
             continue;
         }
@@ -121,8 +97,8 @@ pub fn own_nets(corners: &[Corners], topo: &Topology, smooth: &[bool]) -> Vec<Ne
         let uses: Vec<(usize, [usize; 2])> = edge
             .tris
             .iter()
-            .map(|&(t, k)| {
-                let (t, k) = (t.0 as usize, k as usize);
+            .map(|u| {
+                let (t, k) = u.at();
                 let (i, j) = ((k + 1) % 3, (k + 2) % 3);
                 if topo.tri_verts[t][i] == edge.verts[0] {
                     (t, [i, j])
