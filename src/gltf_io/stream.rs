@@ -1,0 +1,282 @@
+//! A document's output written while the document is still being made: each buffer view goes
+//! to disk as soon as it is added (and its array is freed), the JSON last. With `--check`, the
+//! same bytes are compared with the files on disk as they come instead of being written.
+//!
+//! The bytes are those [`super::write()`] gives: the binary data starts with the input's views
+//! that the output keeps (known before any primitive is replaced, see
+//! [`super::write::views_kept_after_replacing`]), then every view added since, in the order it
+//! was added; [`super::write`] builds the JSON over that layout and checks that every written
+//! view lies where it would have put it.
+//!
+//! The layout of the files:
+//! - `.gltf`: the `.bin` is written in place as it is produced; the `.gltf` when done.
+//! - `.glb`: the JSON chunk comes first, and its length is known only at the end (accessor
+//!   bounds, counts). The binary chunk is written to a second temporary file beside the output
+//!   and, once the JSON is known, copied behind it by the kernel (`copy_file_range`, no pass
+//!   through this process's memory; a reflink on file systems that share blocks). The file is
+//!   byte for byte what [`super::write()`] writes; reserving space for the JSON instead would
+//!   have changed every `.glb` (padding) for a copy that costs a fraction of the write.
+//!
+//! Compressed outputs (`EXT_meshopt_compression`) are not streamed: the compressor plans every
+//! view from the whole document. Neither are quantized ones, since quantization rewrites the
+//! document's primitives after they are all made.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::buffer_data::BufferData;
+use super::compare::Comparison;
+use super::document::Document;
+use super::error::{Error, Result};
+use super::files::bin_path;
+use super::glb;
+use super::write::{self, Staging, WriteOptions};
+
+/// Whether a streamed output is written or compared with what is on disk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StreamMode {
+    /// Write temporary files and rename them into place at the end, all or none.
+    Write,
+    /// Compare with the files on disk; write nothing.
+    Check,
+}
+
+/// What a finished streamed output did.
+#[derive(Debug, Clone, Default)]
+pub struct Streamed {
+    /// Every file of the output with its length in bytes, in the order they are written.
+    pub files: Vec<(PathBuf, u64)>,
+    /// [`StreamMode::Check`]: the first file (in that order) that differs from what is on disk,
+    /// or is missing.
+    pub stale: Option<PathBuf>,
+}
+
+/// Where the binary data goes as it is produced.
+enum Sink {
+    Write(Staging),
+    Compare(Comparison),
+}
+
+/// An output being written (or compared) while its document is made: see the module
+/// documentation.
+pub struct StreamedOutput {
+    path: PathBuf,
+    as_glb: bool,
+    embed_images: bool,
+    sink: Sink,
+    /// Bytes of binary data produced so far.
+    len: usize,
+    /// The views written so far, with the offset of each in the binary data.
+    written: BTreeMap<usize, usize>,
+    /// The first view and the first buffer not yet looked at.
+    next_view: usize,
+    next_buffer: usize,
+}
+
+impl std::fmt::Debug for StreamedOutput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StreamedOutput")
+            .field("path", &self.path)
+            .field("len", &self.len)
+            .field("views", &self.written.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl StreamedOutput {
+    /// Starts the output of `doc` at `path` (`.glb`, or `.gltf` + `<stem>.bin`), where the
+    /// triangle primitives `replacing` are about to be replaced: refuses to overwrite the
+    /// input as [`super::write()`] does, and writes (or compares) the input's views the
+    /// output keeps.
+    pub fn begin(
+        doc: &Document,
+        path: &Path,
+        opts: &WriteOptions,
+        replacing: &[(usize, usize)],
+        mode: StreamMode,
+    ) -> Result<StreamedOutput> {
+        if opts.compression.is_some() {
+            return Err(Error::invalid(
+                "output",
+                "a compressed output is not streamed (expected the whole document at once)",
+            ));
+        }
+        let as_glb = write::is_glb_name(path)?;
+        let bin = (!as_glb).then(|| bin_path(path));
+        write::refuse_overwriting_input(doc, path, bin.as_deref(), opts)?;
+        let sink = match (mode, &bin) {
+            (StreamMode::Write, Some(bin)) => Sink::Write(Staging::new(bin)?),
+            (StreamMode::Write, None) => Sink::Write(Staging::new(path)?),
+            (StreamMode::Check, Some(bin)) => Sink::Compare(Comparison::open(bin)),
+            (StreamMode::Check, None) => Sink::Compare(Comparison::at(path, glb_bin_start(path))),
+        };
+        let mut out = StreamedOutput {
+            path: path.to_path_buf(),
+            as_glb,
+            embed_images: !write::same_dir(doc.base_dir.as_deref(), write::parent_dir(path)),
+            sink,
+            len: 0,
+            written: BTreeMap::new(),
+            next_view: doc.root.buffer_views.len(),
+            next_buffer: doc.buffers.len(),
+        };
+        for view in write::views_kept_after_replacing(doc, replacing)? {
+            out.put_view(doc, view)?;
+        }
+        Ok(out)
+    }
+
+    /// Writes every buffer view added to `doc` since the last call, in order, and frees the
+    /// arrays that held them.
+    pub fn flush(&mut self, doc: &mut Document) -> Result<()> {
+        for view in self.next_view..doc.root.buffer_views.len() {
+            self.put_view(doc, view)?;
+        }
+        self.next_view = doc.root.buffer_views.len();
+        for b in self.next_buffer..doc.buffers.len() {
+            // A new array buffer holds exactly one view, written above.
+            if doc.root.buffers[b].name.as_deref() == Some(super::document::ARRAY_BUFFER_NAME) {
+                doc.buffers[b] = Arc::new(BufferData::default());
+            }
+        }
+        self.next_buffer = doc.buffers.len();
+        Ok(())
+    }
+
+    fn put_view(&mut self, doc: &Document, view: usize) -> Result<()> {
+        let bytes = doc.view_bytes(view)?;
+        let at = self.len.next_multiple_of(4);
+        self.put(&[0; 3][..at - self.len])?;
+        self.put(bytes)?;
+        self.written.insert(view, at);
+        Ok(())
+    }
+
+    fn put(&mut self, bytes: &[u8]) -> Result<()> {
+        match &mut self.sink {
+            Sink::Write(s) => s.write(bytes)?,
+            Sink::Compare(c) => c.feed(bytes),
+        }
+        self.len += bytes.len();
+        Ok(())
+    }
+
+    /// Writes the rest (images to embed, the JSON) and renames every file into place, all or
+    /// none ([`StreamMode::Write`]); or compares the rest and says which file differs
+    /// ([`StreamMode::Check`]). On an error nothing is renamed and the temporary files are
+    /// removed.
+    pub fn finish(mut self, doc: &Document) -> Result<Streamed> {
+        self.flush_nothing_new(doc)?;
+        let bin_path = (!self.as_glb).then(|| bin_path(&self.path));
+        let (json, bin) = write::assemble_after_stream(
+            doc,
+            self.embed_images,
+            bin_path.as_deref(),
+            &self.written,
+        )?;
+        if bin.on_disk() != self.len {
+            return Err(Error::invalid(
+                "output",
+                "the binary data written differs from its layout (please report)",
+            ));
+        }
+        for piece in bin.iter() {
+            self.put(piece)?;
+        }
+        let shown = self.path.display().to_string();
+        if self.as_glb {
+            let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
+            let (head, tail) = glb::frame(&text, self.len);
+            let total = (head.len() + self.len + tail.len()) as u64;
+            let files = vec![(self.path.clone(), total)];
+            match self.sink {
+                Sink::Write(spool) => {
+                    let spool = spool.written_out()?;
+                    let mut glb = Staging::new(&self.path)?;
+                    glb.write(&head)?;
+                    glb.copy_from(spool, self.len as u64)?;
+                    glb.write(tail)?;
+                    persist(glb.finish()?, &self.path)?;
+                    Ok(Streamed { files, stale: None })
+                }
+                Sink::Compare(mut body) => {
+                    let mut start = Comparison::open(&self.path);
+                    start.feed(&head);
+                    // Without binary data there is no binary chunk: the head is the file.
+                    let same = if self.len == 0 {
+                        start.finish()
+                    } else {
+                        body.feed(tail);
+                        body.finish() && start.matches_so_far()
+                    };
+                    let stale = (!same).then(|| self.path.clone());
+                    Ok(Streamed { files, stale })
+                }
+            }
+        } else {
+            let mut text =
+                serde_json::to_vec_pretty(&json).map_err(|e| Error::invalid(&shown, e))?;
+            text.push(b'\n');
+            let bin_path = bin_path.expect("a .gltf has a .bin path");
+            let has_bin = self.len > 0;
+            let mut files = Vec::with_capacity(2);
+            if has_bin {
+                files.push((bin_path.clone(), self.len as u64));
+            }
+            files.push((self.path.clone(), text.len() as u64));
+            match self.sink {
+                Sink::Write(bin) => {
+                    // Both files are complete on disk before either is renamed.
+                    let bin = has_bin.then(|| bin.finish()).transpose()?;
+                    let gltf = write::stage_bytes(&self.path, &text)?;
+                    if let Some(bin) = bin {
+                        persist(bin, &bin_path)?;
+                    }
+                    persist(gltf, &self.path)?;
+                    Ok(Streamed { files, stale: None })
+                }
+                Sink::Compare(bin) => {
+                    let mut json = Comparison::open(&self.path);
+                    json.feed(&text);
+                    let stale = if has_bin && !bin.finish() {
+                        Some(bin_path)
+                    } else if !json.finish() {
+                        Some(self.path.clone())
+                    } else {
+                        None
+                    };
+                    Ok(Streamed { files, stale })
+                }
+            }
+        }
+    }
+
+    /// Refuses to finish with views added since the last [`StreamedOutput::flush`]: they would
+    /// have to be written after bytes that are already on disk.
+    fn flush_nothing_new(&self, doc: &Document) -> Result<()> {
+        if doc.root.buffer_views.len() != self.next_view {
+            return Err(Error::invalid(
+                "output",
+                "views were added after the last flush (please report)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn persist(tmp: tempfile::NamedTempFile, path: &Path) -> Result<()> {
+    tmp.persist(path)
+        .map_err(|e| Error::io(path.display(), e.error))?;
+    Ok(())
+}
+
+/// Where the binary chunk's data starts in the `.glb` at `path`, from its header (`None`: no
+/// file, or not a GLB with a JSON chunk first, so that no streamed comparison can match).
+fn glb_bin_start(path: &Path) -> Option<u64> {
+    use std::io::Read as _;
+    let mut head = [0u8; 20];
+    std::fs::File::open(path).ok()?.read_exact(&mut head).ok()?;
+    let word = |at: usize| u32::from_le_bytes([head[at], head[at + 1], head[at + 2], head[at + 3]]);
+    (glb::is_glb(&head) && word(16) == glb::CHUNK_JSON).then(|| 20 + u64::from(word(12)) + 8)
+}
