@@ -280,3 +280,107 @@ fn glb_bin_start(path: &Path) -> Option<u64> {
     let word = |at: usize| u32::from_le_bytes([head[at], head[at + 1], head[at + 2], head[at + 3]]);
     (glb::is_glb(&head) && word(16) == glb::CHUNK_JSON).then(|| 20 + u64::from(word(12)) + 8)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gltf_io::{read_bytes, replace_primitive_owned, Attribute, PrimitiveData};
+
+    /// One triangle, its positions in a `data:` buffer.
+    fn triangle() -> Document {
+        let floats: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
+            .iter()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::Engine::encode(&base64::engine::general_purpose::STANDARD, &floats)
+        );
+        let json = serde_json::json!({
+            "asset": { "version": "2.0" },
+            "buffers": [{ "byteLength": 36, "uri": uri }],
+            "bufferViews": [{ "buffer": 0, "byteLength": 36 }],
+            "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                            "min": [0, 0, 0], "max": [1, 1, 0] }],
+            "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 } }] }],
+        });
+        read_bytes(
+            &serde_json::to_vec(&json).unwrap(),
+            None,
+            &Default::default(),
+        )
+        .unwrap()
+    }
+
+    /// A strip of `n` triangles.
+    fn strip(n: u32) -> PrimitiveData {
+        let positions = (0..n + 2)
+            .flat_map(|i| [i as f32, (i % 2) as f32, 0.0])
+            .collect();
+        PrimitiveData {
+            attributes: vec![Attribute::float("POSITION", 3, positions)],
+            indices: (0..n).flat_map(|i| [i, i + 1, i + 2]).collect(),
+            targets: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn flushed_arrays_are_freed_and_the_file_is_what_the_writer_gives() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.glb");
+        let opts = WriteOptions::default();
+        let mut in_memory = triangle();
+        replace_primitive_owned(&mut in_memory, 0, 0, strip(100_000)).unwrap();
+        let expected = write::encode(&in_memory, &path, &opts).unwrap();
+
+        let mut doc = triangle();
+        let mut out =
+            StreamedOutput::begin(&doc, &path, &opts, &[(0, 0)], StreamMode::Write).unwrap();
+        replace_primitive_owned(&mut doc, 0, 0, strip(100_000)).unwrap();
+        let held = doc.buffer_bytes();
+        assert!(held > 100_000 * 12, "{held}");
+        out.flush(&mut doc).unwrap();
+        // Only the input's buffer (36 bytes) is left.
+        assert!(
+            doc.buffer_bytes() < 1000,
+            "{} still held",
+            doc.buffer_bytes()
+        );
+        let done = out.finish(&doc).unwrap();
+        assert_eq!(done.files, vec![(path.clone(), expected[0].len())]);
+        assert_eq!(std::fs::read(&path).unwrap(), expected[0].to_bytes());
+
+        // Checked against that file: the same; against one byte more: not.
+        let check = |doc: &mut Document| {
+            let mut out =
+                StreamedOutput::begin(doc, &path, &opts, &[(0, 0)], StreamMode::Check).unwrap();
+            replace_primitive_owned(doc, 0, 0, strip(100_000)).unwrap();
+            out.flush(doc).unwrap();
+            out.finish(doc).unwrap().stale
+        };
+        assert_eq!(check(&mut triangle()), None);
+        let mut longer = std::fs::read(&path).unwrap();
+        longer.push(0);
+        std::fs::write(&path, longer).unwrap();
+        assert_eq!(check(&mut triangle()), Some(path.clone()));
+    }
+
+    #[test]
+    fn views_added_after_the_last_flush_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.gltf");
+        let mut doc = triangle();
+        let out = StreamedOutput::begin(
+            &doc,
+            &path,
+            &WriteOptions::default(),
+            &[(0, 0)],
+            StreamMode::Write,
+        )
+        .unwrap();
+        replace_primitive_owned(&mut doc, 0, 0, strip(10)).unwrap();
+        assert!(out.finish(&doc).is_err());
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "temporary files left: {left:?}");
+    }
+}
