@@ -3,10 +3,10 @@
 //! same bytes are compared with the files on disk as they come instead of being written.
 //!
 //! The bytes are those [`super::write()`] gives: the binary data starts with the input's views
-//! that the output keeps (known before any primitive is replaced, see
-//! [`super::write::views_kept_after_replacing`]), then every view added since, in the order it
-//! was added; [`super::write`] builds the JSON over that layout and checks that every written
-//! view lies where it would have put it.
+//! that the output keeps (known before any primitive is replaced, from what the replaced
+//! primitives referred to), then every view added since, in the order it was added; the writer
+//! ([`mod@super::write`]) builds the JSON over that layout and checks that every written view
+//! lies where it would have put it.
 //!
 //! The layout of the files:
 //! - `.gltf`: the `.bin` is written in place as it is produced; the `.gltf` when done.
