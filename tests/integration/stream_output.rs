@@ -13,15 +13,7 @@ use g2tess::pipeline;
 use crate::corpus;
 use crate::hostile::{run_limited, verdict, write_tetrahedron};
 
-/// Every file under `dir`, relative to it.
-fn tree(dir: &Path) -> BTreeSet<PathBuf> {
-    walkdir::WalkDir::new(dir)
-        .into_iter()
-        .filter_map(Result::ok)
-        .filter(|e| !e.file_type().is_dir())
-        .map(|e| e.path().strip_prefix(dir).unwrap().to_path_buf())
-        .collect()
-}
+use crate::hostile::files_under as tree;
 
 fn level(l: u32) -> Options {
     let mut options = Options::default();
@@ -223,11 +215,7 @@ fn a_glb_whose_copy_behind_the_json_fails_keeps_the_previous_output() {
     // 20 KB of extras make the JSON chunk large; the level is raised until the binary chunk is
     // larger still. A file-size limit just under the whole .glb then lets the staged binary
     // chunk and the JSON through, and fails the copy of the binary chunk behind the JSON.
-    let input = write_tetrahedron(root.path(), "t.gltf", "t.bin", Some(Path::new("t.bin")));
-    let mut json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(&input).unwrap()).unwrap();
-    json["extras"] = serde_json::json!({ "pad": "x".repeat(20_000) });
-    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let input = crate::hostile::tetrahedron_with_large_json(root.path(), 20_000);
     let out_dir = root.path().join("out");
     std::fs::create_dir(&out_dir).unwrap();
     let out = out_dir.join("t.glb");
