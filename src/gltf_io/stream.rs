@@ -13,9 +13,11 @@
 //! - `.glb`: the JSON chunk comes first, and its length is known only at the end (accessor
 //!   bounds, counts). The binary chunk is written to a second temporary file beside the output
 //!   and, once the JSON is known, copied behind it by the kernel (`copy_file_range`, no pass
-//!   through this process's memory; a reflink on file systems that share blocks). The file is
-//!   byte for byte what [`super::write()`] writes; reserving space for the JSON instead would
-//!   have changed every `.glb` (padding) for a copy that costs a fraction of the write.
+//!   through this process's memory; a reflink on file systems that share blocks). The last
+//!   mesh's arrays, in memory anyway until the end, are not staged but written behind the copy
+//!   from where they lie: a one-mesh file is written once, as before. The file is byte for byte
+//!   what [`super::write()`] writes; reserving space for the JSON instead would have changed
+//!   every `.glb` (padding).
 //!
 //! Compressed outputs (`EXT_meshopt_compression`) are not streamed: the compressor plans every
 //! view from the whole document. Neither are quantized ones, since quantization rewrites the
@@ -107,7 +109,7 @@ impl StreamedOutput {
         write::refuse_overwriting_input(doc, path, bin.as_deref(), opts)?;
         let sink = match (mode, &bin) {
             (StreamMode::Write, Some(bin)) => Sink::Write(Staging::new(bin)?),
-            (StreamMode::Write, None) => Sink::Write(Staging::new(path)?),
+            (StreamMode::Write, None) => Sink::Write(Staging::aside(path)?),
             (StreamMode::Check, Some(bin)) => Sink::Compare(Comparison::open(bin)),
             (StreamMode::Check, None) => Sink::Compare(Comparison::at(path, glb_bin_start(path))),
         };
@@ -128,8 +130,16 @@ impl StreamedOutput {
     }
 
     /// Writes every buffer view added to `doc` since the last call, in order, and frees the
-    /// arrays that held them.
-    pub fn flush(&mut self, doc: &mut Document) -> Result<()> {
+    /// arrays that held them. `last`: no view will be added after these; a `.glb` then keeps
+    /// them in memory and writes them behind the staged binary data at the end, since staging
+    /// them would only copy them once more (for a one-mesh file, all of its arrays).
+    pub fn flush(&mut self, doc: &mut Document, last: bool) -> Result<()> {
+        let keep = last && self.as_glb && matches!(self.sink, Sink::Write(_));
+        if keep {
+            self.next_view = doc.root.buffer_views.len();
+            self.next_buffer = doc.buffers.len();
+            return Ok(());
+        }
         for view in self.next_view..doc.root.buffer_views.len() {
             self.put_view(doc, view)?;
         }
@@ -181,25 +191,40 @@ impl StreamedOutput {
                 "the binary data written differs from its layout (please report)",
             ));
         }
+        let staged = self.len;
+        let shown = self.path.display().to_string();
+        if self.as_glb && matches!(self.sink, Sink::Write(_)) {
+            // The staged bytes are copied behind the JSON, then what is still in memory.
+            let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
+            let (head, tail) = glb::frame(&text, bin.len());
+            let total = (head.len() + bin.len() + tail.len()) as u64;
+            let Sink::Write(spool) = self.sink else {
+                unreachable!("matched above")
+            };
+            let spool = spool.written_out()?;
+            let mut glb = Staging::new(&self.path)?;
+            glb.write(&head)?;
+            glb.copy_from(spool, staged as u64)?;
+            for piece in bin.iter() {
+                glb.write(piece)?;
+            }
+            glb.write(tail)?;
+            persist(glb.finish()?, &self.path)?;
+            return Ok(Streamed {
+                files: vec![(self.path.clone(), total)],
+                stale: None,
+            });
+        }
         for piece in bin.iter() {
             self.put(piece)?;
         }
-        let shown = self.path.display().to_string();
         if self.as_glb {
             let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
             let (head, tail) = glb::frame(&text, self.len);
             let total = (head.len() + self.len + tail.len()) as u64;
             let files = vec![(self.path.clone(), total)];
             match self.sink {
-                Sink::Write(spool) => {
-                    let spool = spool.written_out()?;
-                    let mut glb = Staging::new(&self.path)?;
-                    glb.write(&head)?;
-                    glb.copy_from(spool, self.len as u64)?;
-                    glb.write(tail)?;
-                    persist(glb.finish()?, &self.path)?;
-                    Ok(Streamed { files, stale: None })
-                }
+                Sink::Write(_) => unreachable!("written above"),
                 Sink::Compare(mut body) => {
                     let mut start = Comparison::open(&self.path);
                     start.feed(&head);
@@ -339,7 +364,7 @@ mod tests {
         replace_primitive_owned(&mut doc, 0, 0, strip(100_000)).unwrap();
         let held = doc.buffer_bytes();
         assert!(held > 100_000 * 12, "{held}");
-        out.flush(&mut doc).unwrap();
+        out.flush(&mut doc, false).unwrap();
         // Only the input's buffer (36 bytes) is left.
         assert!(
             doc.buffer_bytes() < 1000,
@@ -355,7 +380,7 @@ mod tests {
             let mut out =
                 StreamedOutput::begin(doc, &path, &opts, &[(0, 0)], StreamMode::Check).unwrap();
             replace_primitive_owned(doc, 0, 0, strip(100_000)).unwrap();
-            out.flush(doc).unwrap();
+            out.flush(doc, true).unwrap();
             out.finish(doc).unwrap().stale
         };
         assert_eq!(check(&mut triangle()), None);

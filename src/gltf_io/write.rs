@@ -305,9 +305,20 @@ pub(crate) struct Staging {
     shown: String,
     written: u64,
     handed: u64,
+    /// Whether written bytes are handed to the disk as they come (not for bytes set aside,
+    /// which are copied and removed before they would ever need to be on disk).
+    writeback: bool,
 }
 
 impl Staging {
+    /// Creates the temporary file beside `path` for bytes set aside, to be copied into another
+    /// file and removed: nothing is asked of the disk for them.
+    pub fn aside(path: &Path) -> Result<Staging> {
+        let mut staging = Staging::new(path)?;
+        staging.writeback = false;
+        Ok(staging)
+    }
+
     /// Creates the temporary file beside `path`.
     pub fn new(path: &Path) -> Result<Staging> {
         let shown = path.display().to_string();
@@ -328,6 +339,7 @@ impl Staging {
             shown,
             written: 0,
             handed: 0,
+            writeback: true,
         })
     }
 
@@ -370,6 +382,9 @@ impl Staging {
     /// (or whatever there is, when `now`).
     fn hand_over(&mut self, now: bool) -> Result<()> {
         let pending = self.written - self.handed;
+        if !self.writeback {
+            return Ok(());
+        }
         if pending >= WRITEBACK_STEP as u64 || (now && pending > 0) {
             self.out.flush().map_err(|e| Error::io(&self.shown, e))?;
             start_writeback(self.out.get_ref().as_file(), self.handed, pending);

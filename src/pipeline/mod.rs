@@ -89,8 +89,8 @@ fn stream_file(
         gltf_io::StreamedOutput::begin(&doc, output, &write, &doc.triangle_primitives(), mode)
             .map_err(at_output)?;
     let begin_s = begin_start.elapsed().as_secs_f64();
-    let mut report = smooth_meshes(&mut doc, input, options, &mut |doc| {
-        out.flush(doc).map_err(at_output)
+    let mut report = smooth_meshes(&mut doc, input, options, &mut |doc, last| {
+        out.flush(doc, last).map_err(at_output)
     })?;
     let finish_start = Instant::now();
     let done = out.finish(&doc).map_err(at_output)?;
@@ -182,16 +182,17 @@ pub fn process_document(
     asset: &Path,
     options: &Options,
 ) -> Result<FileReport, Error> {
-    smooth_meshes(doc, asset, options, &mut |_| Ok(()))
+    smooth_meshes(doc, asset, options, &mut |_, _| Ok(()))
 }
 
 /// [`process_document`], calling `stored` after each mesh's new primitives are stored in
-/// `doc` (in file order), so that a writer can take their arrays out at once.
+/// `doc` (in file order; with `true` after the last), so that a writer can take their arrays
+/// out at once.
 fn smooth_meshes(
     doc: &mut Document,
     asset: &Path,
     options: &Options,
-    stored: &mut dyn FnMut(&mut Document) -> Result<(), Error>,
+    stored: &mut dyn FnMut(&mut Document, bool) -> Result<(), Error>,
 ) -> Result<FileReport, Error> {
     let sharpness = asset_sharpness(doc, asset, options)?;
     let level = sharpness.level().unwrap_or(options.level);
@@ -215,6 +216,7 @@ fn smooth_meshes(
     // them in file order. Only one such window of outputs (and of decoded inputs) is held at
     // a time, so a file of many large meshes never holds all their outputs at once.
     let window = rayon::current_num_threads().max(1);
+    let mut left = inputs.len();
     let mut inputs = inputs.into_iter();
     loop {
         let batch: Vec<MeshInput> = inputs.by_ref().take(window).collect();
@@ -234,7 +236,8 @@ fn smooth_meshes(
                 gltf_io::replace_primitive_owned(doc, out.report.mesh, prim, data)
                     .map_err(|e| Error::gltf(asset, e))?;
             }
-            stored(doc)?;
+            left -= 1;
+            stored(doc, left == 0)?;
             report.times.write += store_start.elapsed().as_secs_f64();
             report.add_mesh(out.report);
         }

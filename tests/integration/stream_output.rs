@@ -2,7 +2,7 @@
 //! real fixtures, `.glb` and `.gltf`, images embedded or not), `--check` exactly as strict as a
 //! whole-file comparison (one byte changed in either chunk, a truncated or extended file, a
 //! JSON chunk of another length, a missing `.bin`), and a write that fails while the binary
-//! chunk is copied behind the JSON leaves the previous output and no temporary file.
+//! chunk is written behind the JSON leaves the previous output and no temporary file.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -210,11 +210,11 @@ fn check_is_as_strict_as_a_whole_file_comparison() {
 }
 
 #[test]
-fn a_glb_whose_copy_behind_the_json_fails_keeps_the_previous_output() {
+fn a_glb_that_fails_behind_its_json_keeps_the_previous_output() {
     let root = corpus::temp_dir();
     // 20 KB of extras make the JSON chunk large; the level is raised until the binary chunk is
     // larger still. A file-size limit just under the whole .glb then lets the staged binary
-    // chunk and the JSON through, and fails the copy of the binary chunk behind the JSON.
+    // chunk and the JSON through, and fails while the binary chunk is written behind the JSON.
     let input = crate::hostile::tetrahedron_with_large_json(root.path(), 20_000);
     let out_dir = root.path().join("out");
     std::fs::create_dir(&out_dir).unwrap();
