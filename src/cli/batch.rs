@@ -184,23 +184,19 @@ fn write_one(job: &Job, options: &Options) -> Outcome {
     }
 }
 
-/// Makes the output exactly as a run would, and compares every file it would write with disk.
+/// Makes the output exactly as a run would, and compares every file it would write with disk
+/// as it is produced.
 fn check_one(job: &Job, options: &Options) -> Outcome {
-    let encoded = pipeline::guarded(&job.input, || {
-        pipeline::encode_file(&job.input, &job.output, options)
+    let checked = pipeline::guarded(&job.input, || {
+        pipeline::check_file(&job.input, &job.output, options)
     });
-    let (report, files) = match encoded {
+    let (report, stale) = match checked {
         Ok(r) => r,
         Err(e) => return Outcome::failed(e.to_string()),
     };
-    let stale = files.iter().find(|f| {
-        !std::fs::read(&f.path)
-            .ok()
-            .is_some_and(|on_disk| f.same_as(&on_disk))
-    });
     let (status, error) = match stale {
         None => (Status::Unchanged, None),
-        Some(g2tess::gltf_io::OutputFile { path: file, .. }) => (
+        Some(file) => (
             Status::Changed,
             Some(format!(
                 "{}: {} (expected what {} gives now; run without --check to update it)",

@@ -92,14 +92,33 @@ impl Piece {
     }
 }
 
-/// A sequence of pieces with their total length.
+/// A sequence of pieces with their total length. When an output is written as it is produced,
+/// its first bytes are already in the file: `on_disk` counts them, and only what follows them
+/// is held here.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Pieces {
     pieces: Vec<Piece>,
     len: usize,
+    on_disk: usize,
 }
 
 impl Pieces {
+    /// Marks everything up to byte `end` as already written, ending at `end`: only valid while
+    /// nothing is held in memory yet.
+    pub fn extend_on_disk(&mut self, end: usize) {
+        assert!(
+            self.pieces.is_empty() && end >= self.len,
+            "bytes already on disk come before any held in memory"
+        );
+        self.len = end;
+        self.on_disk = end;
+    }
+
+    /// How many of the first bytes are already on disk (not held here).
+    pub fn on_disk(&self) -> usize {
+        self.on_disk
+    }
+
     pub fn len(&self) -> usize {
         self.len
     }
@@ -127,18 +146,21 @@ impl Pieces {
         }
     }
 
-    /// Appends all of `other`.
+    /// Appends all of `other` (which must be held in memory whole).
     pub fn extend(&mut self, other: Pieces) {
+        assert_eq!(other.on_disk, 0, "appended bytes are held in memory");
         self.len += other.len;
         self.pieces.extend(other.pieces);
     }
 
+    /// The pieces held in memory, in order (after the bytes on disk).
     pub fn iter(&self) -> impl Iterator<Item = &[u8]> {
         self.pieces.iter().map(Piece::as_bytes)
     }
 
-    /// All pieces in one vector.
+    /// All pieces in one vector (all of them held in memory).
     pub fn concat(&self) -> Vec<u8> {
+        assert_eq!(self.on_disk, 0, "concatenated bytes are held in memory");
         let mut out = Vec::with_capacity(self.len);
         for p in self.iter() {
             out.extend_from_slice(p);

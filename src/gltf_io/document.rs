@@ -389,6 +389,10 @@ fn load_buffers(
     Ok(out)
 }
 
+/// The name of the in-memory buffers that each hold one array the pipeline made (see
+/// [`Document::push_array_view`]).
+pub(crate) const ARRAY_BUFFER_NAME: &str = "g2tess array";
+
 impl Document {
     /// The bytes of buffer view `view`, bounds already checked at read time.
     pub(crate) fn view_bytes(&self, view: usize) -> Result<&[u8]> {
@@ -443,7 +447,7 @@ impl Document {
         let len = data.len();
         self.root.buffers.push(gltf_json::Buffer {
             byte_length: USize64(len as u64),
-            name: Some("g2tess array".into()),
+            name: Some(ARRAY_BUFFER_NAME.into()),
             uri: None,
             extensions: None,
             extras: Default::default(),

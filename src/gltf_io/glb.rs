@@ -6,7 +6,8 @@
 use super::error::{Error, Result};
 
 const MAGIC: &[u8; 4] = b"glTF";
-const CHUNK_JSON: u32 = 0x4E4F_534A;
+/// The chunk type of the JSON chunk.
+pub(crate) const CHUNK_JSON: u32 = 0x4E4F_534A;
 const CHUNK_BIN: u32 = 0x004E_4942;
 
 /// The two chunks of a GLB file.

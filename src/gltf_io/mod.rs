@@ -17,6 +17,8 @@
 //! - [`primitive`]: [`PrimitiveData`] out of and back into a document
 //! - [`json_merge`]: keeps what the typed JSON model loses
 //! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically, streamed from the buffers in memory
+//! - [`stream`]: an output written (or compared with disk) while its document is being made
+//! - `compare`: bytes compared with a file in chunks as they are produced (`--check`)
 //! - [`files`]: the files an asset reads and the files an output consists of, by name
 //! - `bounds`: accessor `min`/`max`, in parallel
 //! - `buffer_data`: buffers held in the element type they were made in, shared with the writer
@@ -25,6 +27,7 @@
 pub mod accessor;
 mod bounds;
 mod buffer_data;
+mod compare;
 pub mod dequantize_nodes;
 pub mod document;
 pub mod draco_decode;
@@ -36,6 +39,7 @@ pub mod meshopt_decode;
 pub mod meshopt_encode;
 pub mod primitive;
 pub mod quantize;
+pub mod stream;
 pub mod uri;
 pub mod validate;
 pub mod write;
@@ -49,6 +53,7 @@ pub use primitive::{
     PrimitiveSize, Values,
 };
 pub use quantize::{quantize, Quantization};
+pub use stream::{StreamMode, Streamed, StreamedOutput};
 pub use write::{
     encode, to_glb_bytes, write, write_files_atomically, Files, OutputFile, WriteOptions,
 };

@@ -6,13 +6,14 @@
 //! interrupted run never leaves a half-written output. It deliberately never overwrites the
 //! input (or a file the input refers to) unless asked to.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde_json::{json, Map, Value};
 
 use super::buffer_data::Pieces;
+use super::compare::Comparison;
 use super::document::Document;
 use super::error::{Error, Result};
 use super::files::{bin_path, fallback_path};
@@ -78,17 +79,14 @@ impl OutputFile {
         self.bytes.concat()
     }
 
-    /// Whether `other` holds exactly its bytes.
-    pub fn same_as(&self, other: &[u8]) -> bool {
-        if other.len() != self.bytes.len() {
-            return false;
+    /// Whether the file at its path holds exactly its bytes, read in chunks beside them (never
+    /// whole) and only up to the first difference.
+    pub fn matches_disk(&self) -> bool {
+        let mut on_disk = Comparison::open(&self.path);
+        for piece in self.bytes.iter() {
+            on_disk.feed(piece);
         }
-        let mut rest = other;
-        self.bytes.iter().all(|piece| {
-            let (head, tail) = rest.split_at(piece.len());
-            rest = tail;
-            head == piece
-        })
+        on_disk.finish()
     }
 
     /// Writes it to a temporary file beside its path, then renames it into place.
@@ -133,20 +131,7 @@ pub fn write(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<()> {
 /// It exists so that a caller can compare a fresh result with what is on disk (`--check`).
 pub fn encode(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<Files> {
     let shown = path.display().to_string();
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let as_glb = match ext.as_deref() {
-        Some("glb") => true,
-        Some("gltf") => false,
-        _ => {
-            return Err(Error::invalid(
-                "output name",
-                "has no .glb or .gltf extension (expected one of them)",
-            ))
-        }
-    };
+    let as_glb = is_glb_name(path)?;
     let bin_path = (!as_glb).then(|| bin_path(path));
     let fallback = opts
         .compression
@@ -164,6 +149,7 @@ pub fn encode(doc: &Document, path: &Path, opts: &WriteOptions) -> Result<Files>
         bin_path.as_deref(),
         opts.compression,
         fallback.as_deref(),
+        None,
     )?;
     let mut files = Vec::with_capacity(3);
     if let (Some(f), Some(bytes)) = (fallback, fallback_bytes) {
@@ -197,19 +183,35 @@ pub fn to_glb_bytes(doc: &Document, compression: Option<Compression>) -> Result<
             "a compressed output with a fallback buffer needs a file beside it (expected a path)",
         ));
     }
-    let (json, bin, _) = assemble(doc, false, None, compression, None)?;
+    let (json, bin, _) = assemble(doc, false, None, compression, None, None)?;
     let text = serde_json::to_vec(&json).map_err(|e| Error::invalid("json", e))?;
     Ok(glb::assemble(&text, &bin.concat()))
 }
 
-fn parent_dir(path: &Path) -> &Path {
+/// Whether `path` names a `.glb` (`false`: a `.gltf`); any other name is an error.
+pub(crate) fn is_glb_name(path: &Path) -> Result<bool> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("glb") => Ok(true),
+        Some("gltf") => Ok(false),
+        _ => Err(Error::invalid(
+            "output name",
+            "has no .glb or .gltf extension (expected one of them)",
+        )),
+    }
+}
+
+pub(crate) fn parent_dir(path: &Path) -> &Path {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     }
 }
 
-fn same_dir(a: Option<&Path>, b: &Path) -> bool {
+pub(crate) fn same_dir(a: Option<&Path>, b: &Path) -> bool {
     let canon = |p: &Path| std::fs::canonicalize(p).ok();
     a.is_some_and(|a| canon(a).is_some() && canon(a) == canon(b))
 }
@@ -222,7 +224,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 /// Refuses to replace the input, or a buffer or image file it refers to, unless forced.
-fn refuse_overwriting_input(
+pub(crate) fn refuse_overwriting_input(
     doc: &Document,
     path: &Path,
     bin: Option<&Path>,
@@ -275,44 +277,138 @@ fn write_pieces_atomically<'a>(path: &Path, pieces: impl Iterator<Item = &'a [u8
     Ok(())
 }
 
+/// Writes `bytes` to a new temporary file in `path`'s folder and flushes it to disk; dropping
+/// the result removes it.
+pub(crate) fn stage_bytes(path: &Path, bytes: &[u8]) -> Result<tempfile::NamedTempFile> {
+    stage(path, std::iter::once(bytes))
+}
+
 /// Writes the concatenation of `pieces` to a new temporary file in `path`'s folder and flushes
 /// it to disk; dropping the result removes it.
 fn stage<'a>(
     path: &Path,
     pieces: impl Iterator<Item = &'a [u8]>,
 ) -> Result<tempfile::NamedTempFile> {
-    let shown = path.display().to_string();
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".g2tess-").suffix(".tmp");
-    // Temporary files are private (0600); the finished output gets the usual permissions.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt as _;
-        builder.permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    let tmp = builder
-        .tempfile_in(parent_dir(path))
-        .map_err(|e| Error::io(&shown, e))?;
-    // Small pieces (headers, padding) are gathered; large ones go to the file directly, in
-    // steps, each handed to the disk as soon as it is written.
-    let mut out = std::io::BufWriter::with_capacity(1 << 16, tmp);
-    let (mut written, mut handed) = (0u64, 0u64);
+    let mut staging = Staging::new(path)?;
     for piece in pieces {
-        for step in piece.chunks(WRITEBACK_STEP) {
-            out.write_all(step).map_err(|e| Error::io(&shown, e))?;
-            written += step.len() as u64;
-            if written - handed >= WRITEBACK_STEP as u64 {
-                out.flush().map_err(|e| Error::io(&shown, e))?;
-                start_writeback(out.get_ref().as_file(), handed, written - handed);
-                handed = written;
-            }
-        }
+        staging.write(piece)?;
     }
-    let tmp = out
-        .into_inner()
-        .map_err(|e| Error::io(&shown, e.into_error()))?;
-    tmp.as_file().sync_all().map_err(|e| Error::io(&shown, e))?;
-    Ok(tmp)
+    staging.finish()
+}
+
+/// A new temporary file in a target's folder, written front to back: the target's contents
+/// before they are renamed into place, or bytes kept aside until they are (the binary chunk of
+/// a `.glb` whose JSON chunk, which comes first, is not known yet). Dropped unfinished, the
+/// file is removed.
+pub(crate) struct Staging {
+    out: std::io::BufWriter<tempfile::NamedTempFile>,
+    shown: String,
+    written: u64,
+    handed: u64,
+    /// Whether written bytes are handed to the disk as they come (not for bytes set aside,
+    /// which are copied and removed before they would ever need to be on disk).
+    writeback: bool,
+}
+
+impl Staging {
+    /// Creates the temporary file beside `path` for bytes set aside, to be copied into another
+    /// file and removed: nothing is asked of the disk for them.
+    pub fn aside(path: &Path) -> Result<Staging> {
+        let mut staging = Staging::new(path)?;
+        staging.writeback = false;
+        Ok(staging)
+    }
+
+    /// Creates the temporary file beside `path`.
+    pub fn new(path: &Path) -> Result<Staging> {
+        let shown = path.display().to_string();
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(".g2tess-").suffix(".tmp");
+        // Temporary files are private (0600); the finished output gets the usual permissions.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt as _;
+            builder.permissions(std::fs::Permissions::from_mode(0o644));
+        }
+        let tmp = builder
+            .tempfile_in(parent_dir(path))
+            .map_err(|e| Error::io(&shown, e))?;
+        Ok(Staging {
+            // Small pieces (headers, padding) are gathered; large ones go to the file directly.
+            out: std::io::BufWriter::with_capacity(1 << 16, tmp),
+            shown,
+            written: 0,
+            handed: 0,
+            writeback: true,
+        })
+    }
+
+    /// Appends `bytes`, in steps, each handed to the disk as soon as it is written.
+    pub fn write(&mut self, bytes: &[u8]) -> Result<()> {
+        for step in bytes.chunks(WRITEBACK_STEP) {
+            self.out
+                .write_all(step)
+                .map_err(|e| Error::io(&self.shown, e))?;
+            self.written += step.len() as u64;
+            self.hand_over(false)?;
+        }
+        Ok(())
+    }
+
+    /// Appends the first `len` bytes of the finished staging file `from`, copied by the kernel
+    /// (no pass through this process's memory).
+    pub fn copy_from(&mut self, from: tempfile::NamedTempFile, len: u64) -> Result<()> {
+        use std::io::{Read as _, Seek as _};
+        let err = |e| Error::io(&self.shown, e);
+        self.out.flush().map_err(err)?;
+        let mut src = from.reopen().map_err(err)?;
+        src.rewind().map_err(err)?;
+        let copied = std::io::copy(&mut (&mut src).take(len), self.out.get_mut().as_file_mut())
+            .map_err(err)?;
+        if copied != len {
+            return Err(Error::io(
+                &self.shown,
+                std::io::Error::new(
+                    std::io::ErrorKind::UnexpectedEof,
+                    format!("its staged data ended after {copied} of {len} bytes"),
+                ),
+            ));
+        }
+        self.written += len;
+        self.hand_over(true)
+    }
+
+    /// Starts writing back what was written since the last time, once that is a whole step
+    /// (or whatever there is, when `now`).
+    fn hand_over(&mut self, now: bool) -> Result<()> {
+        let pending = self.written - self.handed;
+        if !self.writeback {
+            return Ok(());
+        }
+        if pending >= WRITEBACK_STEP as u64 || (now && pending > 0) {
+            self.out.flush().map_err(|e| Error::io(&self.shown, e))?;
+            start_writeback(self.out.get_ref().as_file(), self.handed, pending);
+            self.handed = self.written;
+        }
+        Ok(())
+    }
+
+    /// Flushes the file to disk and returns it, still temporary.
+    pub fn finish(self) -> Result<tempfile::NamedTempFile> {
+        let shown = self.shown.clone();
+        let tmp = self.written_out()?;
+        tmp.as_file().sync_all().map_err(|e| Error::io(&shown, e))?;
+        Ok(tmp)
+    }
+
+    /// The file with everything written handed to the kernel, not waited for: for bytes that
+    /// are copied elsewhere and then removed.
+    pub fn written_out(self) -> Result<tempfile::NamedTempFile> {
+        let shown = self.shown;
+        self.out
+            .into_inner()
+            .map_err(|e| Error::io(&shown, e.into_error()))
+    }
 }
 
 /// Bytes written between two requests to start writing back to disk.
@@ -338,26 +434,32 @@ fn start_writeback(file: &std::fs::File, offset: u64, len: u64) {
 #[cfg(not(target_os = "linux"))]
 fn start_writeback(_file: &std::fs::File, _offset: u64, _len: u64) {}
 
-/// Builds the output JSON, its binary buffer, and (compressed, when asked) the uncompressed
-/// fallback buffer's bytes.
-fn assemble(
+/// The output JSON before repacking: the document as read, with the typed model's changes,
+/// the primitives in `replaced` and the dequantizing nodes; and the typed model alone.
+fn output_json(
     doc: &Document,
-    embed_images: bool,
-    bin_path: Option<&Path>,
-    compression: Option<Compression>,
-    fallback_path: Option<&Path>,
-) -> Result<(Value, Pieces, Option<Vec<u8>>)> {
+    replaced: &BTreeMap<(usize, usize), Value>,
+) -> Result<(Value, Value)> {
     let now = serde_json::to_value(&doc.root).map_err(|e| Error::invalid("json", e))?;
     let mut out = json_merge::merge(&doc.base, &now, &doc.raw);
     let root = out
         .as_object_mut()
         .ok_or_else(|| Error::invalid("json", "top level is not an object"))?;
-    for ((m, p), prim) in &doc.replaced {
+    for ((m, p), prim) in replaced {
         root["meshes"][*m]["primitives"][*p] = prim.clone();
     }
     dequantize_nodes::apply(root, &doc.dequantize);
+    Ok((now, out))
+}
 
-    // Which accessors and views survive.
+/// Which accessors and which buffer views of `doc` the output whose JSON is `root` keeps: what
+/// it refers to, and whatever no replaced primitive left behind (`replaced_accessors`: the
+/// accessors the replaced primitives referred to when read).
+fn kept_items(
+    doc: &Document,
+    root: &mut Map<String, Value>,
+    replaced_accessors: &BTreeSet<usize>,
+) -> Result<(Vec<bool>, Vec<bool>)> {
     let mut referenced = BTreeSet::new();
     for_each_accessor_ref(root, &mut |i| {
         referenced.insert(*i as usize);
@@ -385,19 +487,8 @@ fn assemble(
         ));
     }
     let keep_accessor: Vec<bool> = (0..doc.root.accessors.len())
-        .map(|i| referenced.contains(&i) || !doc.replaced_accessors.contains(&i))
+        .map(|i| referenced.contains(&i) || !replaced_accessors.contains(&i))
         .collect();
-    let accessor_views = |a: &gltf_json::Accessor| {
-        let sparse = a
-            .sparse
-            .iter()
-            .flat_map(|s| [s.indices.buffer_view.value(), s.values.buffer_view.value()]);
-        a.buffer_view
-            .map(|v| v.value())
-            .into_iter()
-            .chain(sparse)
-            .collect::<Vec<_>>()
-    };
     let mut view_used = vec![false; doc.root.buffer_views.len()];
     let mut view_orphaned = vec![false; doc.root.buffer_views.len()];
     for (i, a) in doc.root.accessors.iter().enumerate() {
@@ -415,6 +506,86 @@ fn assemble(
         .zip(&view_orphaned)
         .map(|(u, o)| *u || !*o)
         .collect();
+    Ok((keep_accessor, keep_view))
+}
+
+/// The buffer views accessor `a` reads (its own and its sparse parts').
+fn accessor_views(a: &gltf_json::Accessor) -> Vec<usize> {
+    let sparse = a
+        .sparse
+        .iter()
+        .flat_map(|s| [s.indices.buffer_view.value(), s.values.buffer_view.value()]);
+    a.buffer_view
+        .map(|v| v.value())
+        .into_iter()
+        .chain(sparse)
+        .collect()
+}
+
+/// The buffer views of `doc` as read that its output will still hold once the triangle
+/// primitives `replacing` are replaced (whatever they are replaced with, since new primitives
+/// refer only to new accessors), in the order they are written: the start of the output's
+/// binary data, known before any primitive is replaced.
+pub(crate) fn views_kept_after_replacing(
+    doc: &Document,
+    replacing: &[(usize, usize)],
+) -> Result<Vec<usize>> {
+    let mut replaced = doc.replaced.clone();
+    let mut replaced_accessors = doc.replaced_accessors.clone();
+    for &(m, p) in replacing {
+        let mut json = doc.primitive_json(m, p).cloned().ok_or_else(|| {
+            Error::invalid(format!("meshes[{m}].primitives[{p}]"), "does not exist")
+        })?;
+        super::primitive::collect_accessor_refs(&json, &mut replaced_accessors);
+        // What a replacement removes: its data references, and the Draco stream's view.
+        if let Some(obj) = json.as_object_mut() {
+            for key in ["attributes", "indices", "targets"] {
+                obj.remove(key);
+            }
+            if let Some(ext) = obj.get_mut("extensions").and_then(Value::as_object_mut) {
+                ext.remove(draco_decode::EXTENSION);
+            }
+        }
+        replaced.insert((m, p), json);
+    }
+    let (_, mut out) = output_json(doc, &replaced)?;
+    let root = out
+        .as_object_mut()
+        .ok_or_else(|| Error::invalid("json", "top level is not an object"))?;
+    let (_, keep_view) = kept_items(doc, root, &replaced_accessors)?;
+    Ok((0..keep_view.len()).filter(|v| keep_view[*v]).collect())
+}
+
+/// The output JSON and binary buffer of `doc` (uncompressed) whose views in `written` are
+/// already written, at the offsets given: the returned buffer holds only what follows them.
+pub(crate) fn assemble_after_stream(
+    doc: &Document,
+    embed_images: bool,
+    bin_path: Option<&Path>,
+    written: &BTreeMap<usize, usize>,
+) -> Result<(Value, Pieces)> {
+    let (json, bin, _) = assemble(doc, embed_images, bin_path, None, None, Some(written))?;
+    Ok((json, bin))
+}
+
+/// Builds the output JSON, its binary buffer, and (compressed, when asked) the uncompressed
+/// fallback buffer's bytes.
+///
+/// `written` holds the views already written to the output as it was produced, by index, with
+/// the offset each was written at: they take no memory here, and must come first, in order.
+fn assemble(
+    doc: &Document,
+    embed_images: bool,
+    bin_path: Option<&Path>,
+    compression: Option<Compression>,
+    fallback_path: Option<&Path>,
+    written: Option<&BTreeMap<usize, usize>>,
+) -> Result<(Value, Pieces, Option<Vec<u8>>)> {
+    let (now, mut out) = output_json(doc, &doc.replaced)?;
+    let root = out
+        .as_object_mut()
+        .ok_or_else(|| Error::invalid("json", "top level is not an object"))?;
+    let (keep_accessor, keep_view) = kept_items(doc, root, &doc.replaced_accessors)?;
 
     // Repack every kept view into one buffer.
     let typed_views = now
@@ -425,19 +596,44 @@ fn assemble(
     let mut bin = Pieces::default();
     let mut views = Vec::new();
     let mut view_map = vec![None; keep_view.len()];
+    let mut written_kept = 0;
     for (i, keep) in keep_view.iter().enumerate() {
         if !*keep {
             continue;
         }
-        let piece = doc.view_piece(i)?;
         let mut v = typed_views[i].clone();
-        bin.align4();
         v["buffer"] = json!(0);
-        v["byteOffset"] = json!(bin.len());
-        v["byteLength"] = json!(piece.as_bytes().len());
-        bin.push(piece);
+        match written.and_then(|w| w.get(&i)) {
+            Some(&at) => {
+                // Written already: it must lie where this layout puts it.
+                let len = doc.root.buffer_views[i].byte_length.0 as usize;
+                if bin.len() != bin.on_disk() || at != bin.len().next_multiple_of(4) {
+                    return Err(Error::invalid(
+                        format!("bufferViews[{i}]"),
+                        "was written out of place (please report)",
+                    ));
+                }
+                v["byteOffset"] = json!(at);
+                v["byteLength"] = json!(len);
+                bin.extend_on_disk(at + len);
+                written_kept += 1;
+            }
+            None => {
+                let piece = doc.view_piece(i)?;
+                bin.align4();
+                v["byteOffset"] = json!(bin.len());
+                v["byteLength"] = json!(piece.as_bytes().len());
+                bin.push(piece);
+            }
+        }
         view_map[i] = Some(views.len());
         views.push(v);
+    }
+    if written.is_some_and(|w| w.len() != written_kept) {
+        return Err(Error::invalid(
+            "bufferViews",
+            "a view was written that the output does not keep (please report)",
+        ));
     }
     let typed_accessors = now
         .get("accessors")
@@ -475,6 +671,12 @@ fn assemble(
     }
     set_array(root, "accessors", accessors);
     let fallback = match compression {
+        Some(_) if bin.on_disk() > 0 => {
+            return Err(Error::invalid(
+                "output",
+                "compression needs the whole buffer in memory (please report)",
+            ))
+        }
         Some(c) => {
             let filtered = doc
                 .filtered

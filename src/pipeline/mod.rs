@@ -33,14 +33,75 @@ pub use report::{EdgeFigures, FileReport, MeshReport, PrimitiveReport, StageTime
 pub use warning::{Warning, Warnings};
 
 /// Reads `input`, processes it and writes `output` atomically.
+///
+/// Each mesh's arrays go to the temporary output files as soon as the mesh is done (in mesh
+/// order, so the bytes do not depend on the thread count) and are freed; the files are renamed
+/// into place together at the end. Quantized and compressed outputs, which need the whole
+/// document, are assembled in memory first.
 pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<FileReport, Error> {
+    if !streams(options) {
+        let started = Instant::now();
+        let (mut report, files) = encode_file(input, output, options)?;
+        let write_start = Instant::now();
+        gltf_io::write_files_atomically(&files).map_err(|e| Error::gltf(output, e))?;
+        report.times.write += write_start.elapsed().as_secs_f64();
+        report.times.total = started.elapsed().as_secs_f64();
+        return Ok(report);
+    }
+    stream_file(input, output, options, gltf_io::StreamMode::Write).map(|(report, _)| report)
+}
+
+/// `--check`: makes the output exactly as [`process_file`] would and compares it with the
+/// files on disk as it is produced, writing nothing. Returns the report and the first file
+/// (in the order they are written) that is missing or differs.
+pub fn check_file(
+    input: &Path,
+    output: &Path,
+    options: &Options,
+) -> Result<(FileReport, Option<std::path::PathBuf>), Error> {
+    if !streams(options) {
+        let (report, files) = encode_file(input, output, options)?;
+        let stale = files.iter().find(|f| !f.matches_disk());
+        return Ok((report, stale.map(|f| f.path.clone())));
+    }
+    stream_file(input, output, options, gltf_io::StreamMode::Check)
+        .map(|(report, done)| (report, done.stale))
+}
+
+/// Whether the output under `options` is written as it is produced (see [`process_file`]).
+fn streams(options: &Options) -> bool {
+    options.quantization().is_none() && options.compression().is_none()
+}
+
+/// Reads `input`, processes it and writes (or compares) `output` mesh by mesh.
+fn stream_file(
+    input: &Path,
+    output: &Path,
+    options: &Options,
+    mode: gltf_io::StreamMode,
+) -> Result<(FileReport, gltf_io::Streamed), Error> {
     let started = Instant::now();
-    let (mut report, files) = encode_file(input, output, options)?;
-    let write_start = Instant::now();
-    gltf_io::write_files_atomically(&files).map_err(|e| Error::gltf(output, e))?;
-    report.times.write += write_start.elapsed().as_secs_f64();
+    let mut doc =
+        gltf_io::read(input, &options.read_options()).map_err(|e| Error::gltf(input, e))?;
+    let read_s = started.elapsed().as_secs_f64();
+    let at_output = |e: gltf_io::Error| Error::gltf(output, e);
+    let write = WriteOptions::new(Some(input.to_path_buf()), options.overwrite_input);
+    let begin_start = Instant::now();
+    let mut out =
+        gltf_io::StreamedOutput::begin(&doc, output, &write, &doc.triangle_primitives(), mode)
+            .map_err(at_output)?;
+    let begin_s = begin_start.elapsed().as_secs_f64();
+    let mut report = smooth_meshes(&mut doc, input, options, &mut |doc, last| {
+        out.flush(doc, last).map_err(at_output)
+    })?;
+    let finish_start = Instant::now();
+    let done = out.finish(&doc).map_err(at_output)?;
+    report.times.read = read_s;
+    report.times.write += begin_s + finish_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
-    Ok(report)
+    report.bytes_in = file_size(input);
+    report.bytes_out = done.files.iter().map(|(_, len)| len).sum();
+    Ok((report, done))
 }
 
 /// Every file that processing `asset` under `options` reads: the asset, the buffer and image
@@ -66,9 +127,8 @@ pub fn files_written(output: &Path, options: &Options) -> Vec<std::path::PathBuf
     gltf_io::output_files(output, options.compression())
 }
 
-/// Does everything [`process_file`] does except writing: returns the files it would write
-/// (see [`gltf_io::encode`]) with their bytes, so that a caller can compare them with what is
-/// on disk without touching it.
+/// Does everything [`process_file`] does except writing, all in memory: returns the files it
+/// would write (see [`gltf_io::encode`]) with their bytes.
 pub fn encode_file(
     input: &Path,
     output: &Path,
@@ -124,6 +184,18 @@ pub fn process_document(
     asset: &Path,
     options: &Options,
 ) -> Result<FileReport, Error> {
+    smooth_meshes(doc, asset, options, &mut |_, _| Ok(()))
+}
+
+/// [`process_document`], calling `stored` after each mesh's new primitives are stored in
+/// `doc` (in file order; with `true` after the last), so that a writer can take their arrays
+/// out at once.
+fn smooth_meshes(
+    doc: &mut Document,
+    asset: &Path,
+    options: &Options,
+    stored: &mut dyn FnMut(&mut Document, bool) -> Result<(), Error>,
+) -> Result<FileReport, Error> {
     let sharpness = asset_sharpness(doc, asset, options)?;
     let level = sharpness.level().unwrap_or(options.level);
 
@@ -137,28 +209,41 @@ pub fn process_document(
     let inputs = mesh_inputs(doc, asset)?;
     let decode_s = decode_start.elapsed().as_secs_f64();
 
-    // The meshes are independent: smooth them in parallel, collect in file order.
-    let outputs: Vec<Result<MeshOutput, Error>> = inputs
-        .par_iter()
-        .map(|m| mesh_job::smooth_mesh(m, &sharpness, level, options, asset))
-        .collect();
-
     let mut report = FileReport {
         level,
         ..FileReport::default()
     };
     report.times.decode = decode_s;
-    let store_start = Instant::now();
-    for out in outputs {
-        let out = out?;
-        for (prim, data) in out.primitives {
-            gltf_io::replace_primitive_owned(doc, out.report.mesh, prim, data)
-                .map_err(|e| Error::gltf(asset, e))?;
+    // The meshes are independent: smooth as many in parallel as there are threads, then store
+    // them in file order. Only one such window of outputs (and of decoded inputs) is held at
+    // a time, so a file of many large meshes never holds all their outputs at once.
+    let window = rayon::current_num_threads().max(1);
+    let mut left = inputs.len();
+    let mut inputs = inputs.into_iter();
+    loop {
+        let batch: Vec<MeshInput> = inputs.by_ref().take(window).collect();
+        if batch.is_empty() {
+            break;
         }
-        report.add_mesh(out.report);
+        let outputs: Vec<Result<MeshOutput, Error>> = batch
+            .par_iter()
+            .map(|m| mesh_job::smooth_mesh(m, &sharpness, level, options, asset))
+            .collect();
+        drop(batch);
+        for out in outputs {
+            let out = out?;
+            // Storing the new arrays in the document's buffer is the first half of writing.
+            let store_start = Instant::now();
+            for (prim, data) in out.primitives {
+                gltf_io::replace_primitive_owned(doc, out.report.mesh, prim, data)
+                    .map_err(|e| Error::gltf(asset, e))?;
+            }
+            left -= 1;
+            stored(doc, left == 0)?;
+            report.times.write += store_start.elapsed().as_secs_f64();
+            report.add_mesh(out.report);
+        }
     }
-    // Storing the new arrays in the document's buffer is the first half of writing.
-    report.times.write = store_start.elapsed().as_secs_f64();
     Ok(report)
 }
 

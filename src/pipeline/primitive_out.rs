@@ -183,20 +183,17 @@ pub fn build(
     }
     if !skin_sets.is_empty() {
         let carried = attributes::carry_skin(&skin, tris, &dense.sources);
-        for (set, (joints_name, weights_name)) in skin_sets.iter().enumerate() {
+        let sets = carried.joints.into_iter().zip(carried.weights);
+        for ((joints_name, weights_name), (joints, weights)) in skin_sets.iter().zip(sets) {
             let source = prep.data.attribute(joints_name).expect("found above");
             attributes.push(Attribute {
                 name: joints_name.clone(),
                 components: 4,
-                values: Values::Uint(carried.joints[set].iter().flatten().copied().collect()),
+                values: Values::Uint(joints.into_flattened()),
                 component_type: source.component_type,
                 normalized: false,
             });
-            attributes.push(float_attribute(
-                weights_name,
-                4,
-                carried.weights[set].iter().flatten().copied().collect(),
-            ));
+            attributes.push(float_attribute(weights_name, 4, weights.into_flattened()));
         }
     }
     let uv_of = |set: u32| -> Option<Vec<[f32; 2]>> {
@@ -229,14 +226,6 @@ pub fn build(
                 .collect::<Vec<_>>()
         })
     });
-    if let Some(t) = &base_tangents {
-        attributes.push(float_attribute(
-            TANGENT,
-            4,
-            t.iter().flatten().copied().collect(),
-        ));
-    }
-
     let targets = prep
         .data
         .targets
@@ -254,6 +243,10 @@ pub fn build(
             )
         })
         .collect();
+    // New attributes follow the input's (see the ranks below): the tangents, moved in.
+    if let Some(t) = base_tangents {
+        attributes.push(float_attribute(TANGENT, 4, t.into_flattened()));
+    }
     let DenseMesh {
         positions,
         normals,

@@ -240,6 +240,26 @@ pub fn tetrahedron() -> (Vec<[f32; 3]>, Vec<u32>) {
 
 /// Writes a tetrahedron asset `name` into `dir` whose buffer `uri` is `uri`; returns its path.
 /// The buffer's bytes are written to `bin_at` (relative to `dir`) when given.
+/// Every file under `dir`, relative to it: what a run left behind.
+pub fn files_under(dir: &Path) -> std::collections::BTreeSet<std::path::PathBuf> {
+    walkdir::WalkDir::new(dir)
+        .into_iter()
+        .filter_map(Result::ok)
+        .filter(|e| !e.file_type().is_dir())
+        .map(|e| e.path().strip_prefix(dir).unwrap().to_path_buf())
+        .collect()
+}
+
+/// [`write_tetrahedron`] as `dir/t.gltf` + `dir/t.bin`, with `pad` bytes of extras that every
+/// output carries: a small binary part beside a large JSON part, to fail a write in between.
+pub fn tetrahedron_with_large_json(dir: &Path, pad: usize) -> std::path::PathBuf {
+    let input = write_tetrahedron(dir, "t.gltf", "t.bin", Some(Path::new("t.bin")));
+    let mut json: Value = serde_json::from_slice(&std::fs::read(&input).unwrap()).unwrap();
+    json["extras"] = serde_json::json!({ "pad": "x".repeat(pad) });
+    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    input
+}
+
 pub fn write_tetrahedron(
     dir: &Path,
     name: &str,

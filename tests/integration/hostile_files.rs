@@ -22,12 +22,7 @@ fn os(p: &Path) -> &std::ffi::OsStr {
 
 /// Every file under `dir`, relative to it.
 fn tree(dir: &Path) -> BTreeSet<PathBuf> {
-    walkdir::WalkDir::new(dir)
-        .into_iter()
-        .filter_map(Result::ok)
-        .filter(|e| !e.file_type().is_dir())
-        .map(|e| e.path().strip_prefix(dir).unwrap().to_path_buf())
-        .collect()
+    crate::hostile::files_under(dir)
 }
 
 #[test]
@@ -297,11 +292,7 @@ fn full_disk_keeps_the_previous_gltf_and_bin_together() {
     // A small mesh with a large JSON part (40 KB of extras, carried to the output): the `.bin`
     // fits under the file-size limit and the `.gltf` does not, so the `.bin` would be renamed
     // into place first if the two were not replaced as a set.
-    let input = write_tetrahedron(root.path(), "t.gltf", "t.bin", Some(Path::new("t.bin")));
-    let mut json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(&input).unwrap()).unwrap();
-    json["extras"] = serde_json::json!({ "pad": "x".repeat(40_000) });
-    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let input = crate::hostile::tetrahedron_with_large_json(root.path(), 40_000);
     let out_dir = root.path().join("out");
     let out = out_dir.join("t.gltf");
     let level = |l: &'static str| {

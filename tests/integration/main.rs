@@ -39,6 +39,7 @@ mod schemes_typos;
 mod sharpness_formats;
 mod sharpness_resolve;
 mod sharpness_support;
+mod stream_output;
 mod support;
 mod surface_continuity;
 mod surface_pn;

@@ -1,0 +1,411 @@
+//! A document's output written while the document is still being made: each buffer view goes
+//! to disk as soon as it is added (and its array is freed), the JSON last. With `--check`, the
+//! same bytes are compared with the files on disk as they come instead of being written.
+//!
+//! The bytes are those [`super::write()`] gives: the binary data starts with the input's views
+//! that the output keeps (known before any primitive is replaced, from what the replaced
+//! primitives referred to), then every view added since, in the order it was added; the writer
+//! ([`mod@super::write`]) builds the JSON over that layout and checks that every written view
+//! lies where it would have put it.
+//!
+//! The layout of the files:
+//! - `.gltf`: the `.bin` is written in place as it is produced; the `.gltf` when done.
+//! - `.glb`: the JSON chunk comes first, and its length is known only at the end (accessor
+//!   bounds, counts). The binary chunk is written to a second temporary file beside the output
+//!   and, once the JSON is known, copied behind it by the kernel (`copy_file_range`, no pass
+//!   through this process's memory; a reflink on file systems that share blocks). The last
+//!   mesh's arrays, in memory anyway until the end, are not staged but written behind the copy
+//!   from where they lie: a one-mesh file is written once, as before. The file is byte for byte
+//!   what [`super::write()`] writes; reserving space for the JSON instead would have changed
+//!   every `.glb` (padding).
+//!
+//! Compressed outputs (`EXT_meshopt_compression`) are not streamed: the compressor plans every
+//! view from the whole document. Neither are quantized ones, since quantization rewrites the
+//! document's primitives after they are all made.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::buffer_data::BufferData;
+use super::compare::Comparison;
+use super::document::Document;
+use super::error::{Error, Result};
+use super::files::bin_path;
+use super::glb;
+use super::write::{self, Staging, WriteOptions};
+
+/// Whether a streamed output is written or compared with what is on disk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StreamMode {
+    /// Write temporary files and rename them into place at the end, all or none.
+    Write,
+    /// Compare with the files on disk; write nothing.
+    Check,
+}
+
+/// What a finished streamed output did.
+#[derive(Debug, Clone, Default)]
+pub struct Streamed {
+    /// Every file of the output with its length in bytes, in the order they are written.
+    pub files: Vec<(PathBuf, u64)>,
+    /// [`StreamMode::Check`]: the first file (in that order) that differs from what is on disk,
+    /// or is missing.
+    pub stale: Option<PathBuf>,
+}
+
+/// Where the binary data goes as it is produced.
+enum Sink {
+    Write(Staging),
+    Compare(Comparison),
+}
+
+/// An output being written (or compared) while its document is made: see the module
+/// documentation.
+pub struct StreamedOutput {
+    path: PathBuf,
+    as_glb: bool,
+    embed_images: bool,
+    sink: Sink,
+    /// Bytes of binary data produced so far.
+    len: usize,
+    /// The views written so far, with the offset of each in the binary data.
+    written: BTreeMap<usize, usize>,
+    /// The first view and the first buffer not yet looked at.
+    next_view: usize,
+    next_buffer: usize,
+}
+
+impl std::fmt::Debug for StreamedOutput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StreamedOutput")
+            .field("path", &self.path)
+            .field("len", &self.len)
+            .field("views", &self.written.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl StreamedOutput {
+    /// Starts the output of `doc` at `path` (`.glb`, or `.gltf` + `<stem>.bin`), where the
+    /// triangle primitives `replacing` are about to be replaced: refuses to overwrite the
+    /// input as [`super::write()`] does, and writes (or compares) the input's views the
+    /// output keeps.
+    pub fn begin(
+        doc: &Document,
+        path: &Path,
+        opts: &WriteOptions,
+        replacing: &[(usize, usize)],
+        mode: StreamMode,
+    ) -> Result<StreamedOutput> {
+        if opts.compression.is_some() {
+            return Err(Error::invalid(
+                "output",
+                "a compressed output is not streamed (expected the whole document at once)",
+            ));
+        }
+        let as_glb = write::is_glb_name(path)?;
+        let bin = (!as_glb).then(|| bin_path(path));
+        write::refuse_overwriting_input(doc, path, bin.as_deref(), opts)?;
+        let sink = match (mode, &bin) {
+            (StreamMode::Write, Some(bin)) => Sink::Write(Staging::new(bin)?),
+            (StreamMode::Write, None) => Sink::Write(Staging::aside(path)?),
+            (StreamMode::Check, Some(bin)) => Sink::Compare(Comparison::open(bin)),
+            (StreamMode::Check, None) => Sink::Compare(Comparison::at(path, glb_bin_start(path))),
+        };
+        let mut out = StreamedOutput {
+            path: path.to_path_buf(),
+            as_glb,
+            embed_images: !write::same_dir(doc.base_dir.as_deref(), write::parent_dir(path)),
+            sink,
+            len: 0,
+            written: BTreeMap::new(),
+            next_view: doc.root.buffer_views.len(),
+            next_buffer: doc.buffers.len(),
+        };
+        for view in write::views_kept_after_replacing(doc, replacing)? {
+            out.put_view(doc, view)?;
+        }
+        Ok(out)
+    }
+
+    /// Writes every buffer view added to `doc` since the last call, in order, and frees the
+    /// arrays that held them. `last`: no view will be added after these; a `.glb` then keeps
+    /// them in memory and writes them behind the staged binary data at the end, since staging
+    /// them would only copy them once more (for a one-mesh file, all of its arrays).
+    pub fn flush(&mut self, doc: &mut Document, last: bool) -> Result<()> {
+        let keep = last && self.as_glb && matches!(self.sink, Sink::Write(_));
+        if keep {
+            self.next_view = doc.root.buffer_views.len();
+            self.next_buffer = doc.buffers.len();
+            return Ok(());
+        }
+        for view in self.next_view..doc.root.buffer_views.len() {
+            self.put_view(doc, view)?;
+        }
+        self.next_view = doc.root.buffer_views.len();
+        for b in self.next_buffer..doc.buffers.len() {
+            // A new array buffer holds exactly one view, written above.
+            if doc.root.buffers[b].name.as_deref() == Some(super::document::ARRAY_BUFFER_NAME) {
+                doc.buffers[b] = Arc::new(BufferData::default());
+            }
+        }
+        self.next_buffer = doc.buffers.len();
+        Ok(())
+    }
+
+    fn put_view(&mut self, doc: &Document, view: usize) -> Result<()> {
+        let bytes = doc.view_bytes(view)?;
+        let at = self.len.next_multiple_of(4);
+        self.put(&[0; 3][..at - self.len])?;
+        self.put(bytes)?;
+        self.written.insert(view, at);
+        Ok(())
+    }
+
+    fn put(&mut self, bytes: &[u8]) -> Result<()> {
+        match &mut self.sink {
+            Sink::Write(s) => s.write(bytes)?,
+            Sink::Compare(c) => c.feed(bytes),
+        }
+        self.len += bytes.len();
+        Ok(())
+    }
+
+    /// Writes the rest (images to embed, the JSON) and renames every file into place, all or
+    /// none ([`StreamMode::Write`]); or compares the rest and says which file differs
+    /// ([`StreamMode::Check`]). On an error nothing is renamed and the temporary files are
+    /// removed.
+    pub fn finish(mut self, doc: &Document) -> Result<Streamed> {
+        self.flush_nothing_new(doc)?;
+        let bin_path = (!self.as_glb).then(|| bin_path(&self.path));
+        let (json, bin) = write::assemble_after_stream(
+            doc,
+            self.embed_images,
+            bin_path.as_deref(),
+            &self.written,
+        )?;
+        if bin.on_disk() != self.len {
+            return Err(Error::invalid(
+                "output",
+                "the binary data written differs from its layout (please report)",
+            ));
+        }
+        let staged = self.len;
+        let shown = self.path.display().to_string();
+        if self.as_glb && matches!(self.sink, Sink::Write(_)) {
+            // The staged bytes are copied behind the JSON, then what is still in memory.
+            let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
+            let (head, tail) = glb::frame(&text, bin.len());
+            let total = (head.len() + bin.len() + tail.len()) as u64;
+            let Sink::Write(spool) = self.sink else {
+                unreachable!("matched above")
+            };
+            let spool = spool.written_out()?;
+            let mut glb = Staging::new(&self.path)?;
+            glb.write(&head)?;
+            glb.copy_from(spool, staged as u64)?;
+            for piece in bin.iter() {
+                glb.write(piece)?;
+            }
+            glb.write(tail)?;
+            persist(glb.finish()?, &self.path)?;
+            return Ok(Streamed {
+                files: vec![(self.path.clone(), total)],
+                stale: None,
+            });
+        }
+        for piece in bin.iter() {
+            self.put(piece)?;
+        }
+        if self.as_glb {
+            let text = serde_json::to_vec(&json).map_err(|e| Error::invalid(&shown, e))?;
+            let (head, tail) = glb::frame(&text, self.len);
+            let total = (head.len() + self.len + tail.len()) as u64;
+            let files = vec![(self.path.clone(), total)];
+            match self.sink {
+                Sink::Write(_) => unreachable!("written above"),
+                Sink::Compare(mut body) => {
+                    let mut start = Comparison::open(&self.path);
+                    start.feed(&head);
+                    // Without binary data there is no binary chunk: the head is the file.
+                    let same = if self.len == 0 {
+                        start.finish()
+                    } else {
+                        body.feed(tail);
+                        body.finish() && start.matches_so_far()
+                    };
+                    let stale = (!same).then(|| self.path.clone());
+                    Ok(Streamed { files, stale })
+                }
+            }
+        } else {
+            let mut text =
+                serde_json::to_vec_pretty(&json).map_err(|e| Error::invalid(&shown, e))?;
+            text.push(b'\n');
+            let bin_path = bin_path.expect("a .gltf has a .bin path");
+            let has_bin = self.len > 0;
+            let mut files = Vec::with_capacity(2);
+            if has_bin {
+                files.push((bin_path.clone(), self.len as u64));
+            }
+            files.push((self.path.clone(), text.len() as u64));
+            match self.sink {
+                Sink::Write(bin) => {
+                    // Both files are complete on disk before either is renamed.
+                    let bin = has_bin.then(|| bin.finish()).transpose()?;
+                    let gltf = write::stage_bytes(&self.path, &text)?;
+                    if let Some(bin) = bin {
+                        persist(bin, &bin_path)?;
+                    }
+                    persist(gltf, &self.path)?;
+                    Ok(Streamed { files, stale: None })
+                }
+                Sink::Compare(bin) => {
+                    let mut json = Comparison::open(&self.path);
+                    json.feed(&text);
+                    let stale = if has_bin && !bin.finish() {
+                        Some(bin_path)
+                    } else if !json.finish() {
+                        Some(self.path.clone())
+                    } else {
+                        None
+                    };
+                    Ok(Streamed { files, stale })
+                }
+            }
+        }
+    }
+
+    /// Refuses to finish with views added since the last [`StreamedOutput::flush`]: they would
+    /// have to be written after bytes that are already on disk.
+    fn flush_nothing_new(&self, doc: &Document) -> Result<()> {
+        if doc.root.buffer_views.len() != self.next_view {
+            return Err(Error::invalid(
+                "output",
+                "views were added after the last flush (please report)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn persist(tmp: tempfile::NamedTempFile, path: &Path) -> Result<()> {
+    tmp.persist(path)
+        .map_err(|e| Error::io(path.display(), e.error))?;
+    Ok(())
+}
+
+/// Where the binary chunk's data starts in the `.glb` at `path`, from its header (`None`: no
+/// file, or not a GLB with a JSON chunk first, so that no streamed comparison can match).
+fn glb_bin_start(path: &Path) -> Option<u64> {
+    use std::io::Read as _;
+    let mut head = [0u8; 20];
+    std::fs::File::open(path).ok()?.read_exact(&mut head).ok()?;
+    let word = |at: usize| u32::from_le_bytes([head[at], head[at + 1], head[at + 2], head[at + 3]]);
+    (glb::is_glb(&head) && word(16) == glb::CHUNK_JSON).then(|| 20 + u64::from(word(12)) + 8)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gltf_io::{read_bytes, replace_primitive_owned, Attribute, PrimitiveData};
+
+    /// One triangle, its positions in a `data:` buffer.
+    fn triangle() -> Document {
+        let floats: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
+            .iter()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::Engine::encode(&base64::engine::general_purpose::STANDARD, &floats)
+        );
+        let json = serde_json::json!({
+            "asset": { "version": "2.0" },
+            "buffers": [{ "byteLength": 36, "uri": uri }],
+            "bufferViews": [{ "buffer": 0, "byteLength": 36 }],
+            "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                            "min": [0, 0, 0], "max": [1, 1, 0] }],
+            "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 } }] }],
+        });
+        read_bytes(
+            &serde_json::to_vec(&json).unwrap(),
+            None,
+            &Default::default(),
+        )
+        .unwrap()
+    }
+
+    /// A strip of `n` triangles.
+    fn strip(n: u32) -> PrimitiveData {
+        let positions = (0..n + 2)
+            .flat_map(|i| [i as f32, (i % 2) as f32, 0.0])
+            .collect();
+        PrimitiveData {
+            attributes: vec![Attribute::float("POSITION", 3, positions)],
+            indices: (0..n).flat_map(|i| [i, i + 1, i + 2]).collect(),
+            targets: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn flushed_arrays_are_freed_and_the_file_is_what_the_writer_gives() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.glb");
+        let opts = WriteOptions::default();
+        let mut in_memory = triangle();
+        replace_primitive_owned(&mut in_memory, 0, 0, strip(100_000)).unwrap();
+        let expected = write::encode(&in_memory, &path, &opts).unwrap();
+
+        let mut doc = triangle();
+        let mut out =
+            StreamedOutput::begin(&doc, &path, &opts, &[(0, 0)], StreamMode::Write).unwrap();
+        replace_primitive_owned(&mut doc, 0, 0, strip(100_000)).unwrap();
+        let held = doc.buffer_bytes();
+        assert!(held > 100_000 * 12, "{held}");
+        out.flush(&mut doc, false).unwrap();
+        // Only the input's buffer (36 bytes) is left.
+        assert!(
+            doc.buffer_bytes() < 1000,
+            "{} still held",
+            doc.buffer_bytes()
+        );
+        let done = out.finish(&doc).unwrap();
+        assert_eq!(done.files, vec![(path.clone(), expected[0].len())]);
+        assert_eq!(std::fs::read(&path).unwrap(), expected[0].to_bytes());
+
+        // Checked against that file: the same; against one byte more: not.
+        let check = |doc: &mut Document| {
+            let mut out =
+                StreamedOutput::begin(doc, &path, &opts, &[(0, 0)], StreamMode::Check).unwrap();
+            replace_primitive_owned(doc, 0, 0, strip(100_000)).unwrap();
+            out.flush(doc, true).unwrap();
+            out.finish(doc).unwrap().stale
+        };
+        assert_eq!(check(&mut triangle()), None);
+        let mut longer = std::fs::read(&path).unwrap();
+        longer.push(0);
+        std::fs::write(&path, longer).unwrap();
+        assert_eq!(check(&mut triangle()), Some(path.clone()));
+    }
+
+    #[test]
+    fn views_added_after_the_last_flush_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.gltf");
+        let mut doc = triangle();
+        let out = StreamedOutput::begin(
+            &doc,
+            &path,
+            &WriteOptions::default(),
+            &[(0, 0)],
+            StreamMode::Write,
+        )
+        .unwrap();
+        replace_primitive_owned(&mut doc, 0, 0, strip(10)).unwrap();
+        assert!(out.finish(&doc).is_err());
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "temporary files left: {left:?}");
+    }
+}
