@@ -17,6 +17,7 @@
 //! - [`primitive`]: [`PrimitiveData`] out of and back into a document
 //! - [`json_merge`]: keeps what the typed JSON model loses
 //! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically, streamed from the buffers in memory
+//! - [`lod`]: coarser levels of detail as new meshes and nodes linked by `MSFT_lod`
 //! - [`files`]: the files an asset reads and the files an output consists of, by name
 //! - `bounds`: accessor `min`/`max`, in parallel
 //! - `buffer_data`: buffers held in the element type they were made in, shared with the writer
@@ -32,6 +33,7 @@ pub mod error;
 pub mod files;
 pub mod glb;
 pub mod json_merge;
+pub mod lod;
 pub mod meshopt_decode;
 pub mod meshopt_encode;
 pub mod primitive;

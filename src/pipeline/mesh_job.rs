@@ -16,7 +16,7 @@ use super::density::Density;
 use super::error::Error;
 use super::morph;
 use super::primitive_out::{self, Prepared};
-use super::report::{EdgeFigures, MeshReport, PrimitiveReport};
+use super::report::{EdgeFigures, LodReport, MeshReport, PrimitiveReport};
 use crate::gltf_io::{self, PrimitiveData};
 use crate::mesh::TriMesh;
 use crate::options::Options;
@@ -56,8 +56,10 @@ pub struct MeshInput {
 /// The replacement primitives of one mesh and what it took.
 #[derive(Debug, Clone)]
 pub struct MeshOutput {
-    /// (primitive index, new data), in file order.
+    /// (primitive index, new data), in file order: the finest level.
     pub primitives: Vec<(usize, PrimitiveData)>,
+    /// The coarser levels of a LOD chain, finest first, each as `primitives` is.
+    pub lods: Vec<Vec<(usize, PrimitiveData)>>,
     /// Counts, timings, continuity, warnings.
     pub report: MeshReport,
 }
@@ -167,70 +169,110 @@ pub fn smooth_mesh(
     report.times.surface = lap(&clock, report.times.sharpness);
     stop_if_cancelled(options, asset)?;
 
-    let tess_start = Instant::now();
-    let density = Density::choose(options, level, &mesh, &topo, surface.as_ref());
-    let planned = density.triangle_count(&mesh, &topo);
-    if planned > options.max_output_triangles {
-        return Err(Error::limit(
-            asset,
-            format!(
-                "mesh {} would get {planned} triangles, over --max-triangles {} (expected a larger tolerance, a --triangle-budget or a larger --max-triangles)",
-                input.mesh, options.max_output_triangles
-            ),
-        ));
+    // One level, or every level of the LOD chain from the one surface: only the counts and
+    // the tessellation are per level.
+    let chain = options.lod_levels();
+    let is_chain = !chain.is_empty();
+    let levels = if chain.is_empty() {
+        vec![options.clone()]
+    } else {
+        chain
+    };
+    let mut primitives = Vec::new();
+    let mut lods = Vec::new();
+    for (k, level_options) in levels.iter().enumerate() {
+        let tess_start = Instant::now();
+        let density = Density::choose(level_options, level, &mesh, &topo, surface.as_ref());
+        let planned = density.triangle_count(&mesh, &topo);
+        if planned > options.max_output_triangles {
+            return Err(Error::limit(
+                asset,
+                format!(
+                    "mesh {} would get {planned} triangles, over --max-triangles {} (expected a larger tolerance, a --triangle-budget or a larger --max-triangles)",
+                    input.mesh, options.max_output_triangles
+                ),
+            ));
+        }
+        let mut dense =
+            density.tessellate(&mesh, &topo, &params.effective, surface.as_ref(), &groups);
+        report.times.tessellate += tess_start.elapsed().as_secs_f64();
+        // A chain's report gives each level's reached tolerance, so it is always measured.
+        let figures = density.figures(
+            &topo,
+            surface.as_ref(),
+            &groups,
+            &dense,
+            options.report_figures || is_chain,
+        );
+        stop_if_cancelled(options, asset)?;
+
+        // The tessellator already emits cache-friendly bands with vertices in first-use order:
+        // meshoptimizer's vertex cache pass made both figures worse on its output and took
+        // longer than the tessellation (see `optimize.rs`). Only overdraw ordering remains.
+        let opt_start = Instant::now();
+        let remaps: Vec<Option<Vec<u32>>> = dense
+            .iter_mut()
+            .map(|d| options.overdraw.then(|| optimize::order_for_overdraw(d)))
+            .collect();
+        report.times.optimize += opt_start.elapsed().as_secs_f64();
+
+        let attr_start = Instant::now();
+        let targets = morph::targets(
+            &mesh,
+            &topo,
+            &params.effective,
+            &prepared,
+            &groups,
+            &density,
+            options,
+            &remaps,
+        );
+        let mut level_primitives = Vec::with_capacity(prepared.len());
+        let (mut triangles, mut vertices) = (0, 0);
+        for (j, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
+            triangles += d.indices.len() / 3;
+            vertices += d.positions.len();
+            if k == 0 {
+                report.primitives.push(PrimitiveReport {
+                    primitive: input.primitives[j].index,
+                    triangles_in: prep.data.indices.len() / 3,
+                    vertices_in: prep.source_vertex_count,
+                    triangles_out: d.indices.len() / 3,
+                    vertices_out: d.positions.len(),
+                    cache: options.report_figures.then(|| optimize::cache_figures(&d)),
+                });
+            }
+            let data = primitive_out::build(prep, d, groups[j].start as u32, target);
+            refuse_non_finite(&data, input.mesh, input.primitives[j].index, options)
+                .map_err(|e| Error::gltf(asset, e))?;
+            level_primitives.push((input.primitives[j].index, data));
+        }
+        report.times.attributes += attr_start.elapsed().as_secs_f64();
+        if is_chain {
+            report.lod.push(LodReport {
+                level: k,
+                triangle_budget: (level_options.triangle_budget > 0)
+                    .then_some(level_options.triangle_budget),
+                triangles,
+                vertices,
+                figures: figures.clone().unwrap_or_default(),
+                mesh: None,
+            });
+        }
+        if k == 0 {
+            report.adaptive = figures;
+            primitives = level_primitives;
+        } else {
+            lods.push(level_primitives);
+        }
     }
-    let mut dense = density.tessellate(&mesh, &topo, &params.effective, surface.as_ref(), &groups);
-    report.times.tessellate = tess_start.elapsed().as_secs_f64();
-    report.adaptive = density.figures(
-        &topo,
-        surface.as_ref(),
-        &groups,
-        &dense,
-        options.report_figures,
-    );
-    // The surface holds about 1 kB per input triangle: free it before the attributes are
-    // carried, when the dense mesh is at its largest.
+    // The surface holds about 1 kB per input triangle; it is freed once every level is made.
     drop(surface);
-    stop_if_cancelled(options, asset)?;
-
-    // The tessellator already emits cache-friendly bands with vertices in first-use order:
-    // meshoptimizer's vertex cache pass made both figures worse on its output and took longer
-    // than the tessellation (see `optimize.rs`). Only overdraw ordering remains to do.
-    let opt_start = Instant::now();
-    let remaps: Vec<Option<Vec<u32>>> = dense
-        .iter_mut()
-        .map(|d| options.overdraw.then(|| optimize::order_for_overdraw(d)))
-        .collect();
-    report.times.optimize = opt_start.elapsed().as_secs_f64();
-
-    let attr_start = Instant::now();
-    let mut primitives = Vec::with_capacity(prepared.len());
-    let targets = morph::targets(
-        &mesh,
-        &topo,
-        &params.effective,
-        &prepared,
-        &groups,
-        &density,
-        options,
-        &remaps,
-    );
-    for (k, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
-        report.primitives.push(PrimitiveReport {
-            primitive: input.primitives[k].index,
-            triangles_in: prep.data.indices.len() / 3,
-            vertices_in: prep.source_vertex_count,
-            triangles_out: d.indices.len() / 3,
-            vertices_out: d.positions.len(),
-            cache: options.report_figures.then(|| optimize::cache_figures(&d)),
-        });
-        let data = primitive_out::build(prep, d, groups[k].start as u32, target);
-        refuse_non_finite(&data, input.mesh, input.primitives[k].index, options)
-            .map_err(|e| Error::gltf(asset, e))?;
-        primitives.push((input.primitives[k].index, data));
-    }
-    report.times.attributes = attr_start.elapsed().as_secs_f64();
-    Ok(MeshOutput { primitives, report })
+    Ok(MeshOutput {
+        primitives,
+        lods,
+        report,
+    })
 }
 
 /// No output value is ever non-finite: a surface that overflows f32 (coordinates near its

@@ -28,7 +28,7 @@ use crate::sharpness::{explain_rows, AssetSharpness, Defaults, Sidecar};
 pub use density::AdaptiveFigures;
 pub use error::Error;
 pub use mesh_job::{MeshInput, MeshOutput};
-pub use report::{EdgeFigures, FileReport, MeshReport, PrimitiveReport, StageTimes};
+pub use report::{EdgeFigures, FileReport, LodReport, MeshReport, PrimitiveReport, StageTimes};
 
 /// Reads `input`, processes it and writes `output` atomically.
 pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<FileReport, Error> {
