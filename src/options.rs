@@ -466,6 +466,12 @@ impl Options {
             .copied()
             .chain(self.lod_budget.iter().map(|&b| b as f64))
             .collect();
+        if self.lod_files && set.is_empty() {
+            return Err((
+                "lod_files",
+                "is set without a LOD list (expected lod, lod_relative or lod_budget too)".into(),
+            ));
+        }
         let key = set.first().copied().unwrap_or("lod");
         for (i, &v) in values.iter().enumerate() {
             let ok = match key {

@@ -111,7 +111,19 @@ pub fn link_levels(
             format!("is not an object, so {SCREEN_COVERAGE} cannot be added to it"),
         ));
     }
-    let name = source.get("name").and_then(Value::as_str);
+    // Unnamed nodes take their level names from the mesh's, so engines can still group them.
+    let mesh_name = doc
+        .raw
+        .pointer(&format!("/meshes/{}/name", meshes.first().copied().unwrap_or(0)))
+        .and_then(Value::as_str)
+        .and_then(|n| n.strip_suffix("_LOD1"))
+        .map(str::to_owned);
+    let name = source
+        .get("name")
+        .and_then(Value::as_str)
+        .map(str::to_owned)
+        .or(mesh_name);
+    let name = name.as_deref();
     let mut ids = Vec::with_capacity(meshes.len());
     for (k, &mesh) in meshes.iter().enumerate() {
         let mut lod = Map::new();

@@ -62,6 +62,8 @@ pub struct MeshOutput {
     pub lods: Vec<Vec<(usize, PrimitiveData)>>,
     /// Counts, timings, continuity, warnings.
     pub report: MeshReport,
+    /// The diagonal of the mesh's bounding box, which the LOD chain's coverage hints scale by.
+    pub diagonal: f64,
 }
 
 /// A mesh welded and with its h resolved: what every later stage starts from.
@@ -272,6 +274,7 @@ pub fn smooth_mesh(
         primitives,
         lods,
         report,
+        diagonal: super::density::diagonal(&mesh),
     })
 }
 

@@ -11,6 +11,7 @@
 mod checks;
 mod density;
 mod error;
+pub mod lod;
 mod mesh_job;
 mod morph;
 mod primitive_out;
@@ -60,8 +61,21 @@ pub fn files_read(asset: &Path, options: &Options) -> Vec<std::path::PathBuf> {
 
 /// Every file that [`process_file`] may write for `output` under `options` (the output, a
 /// `.gltf`'s `.bin`, a compressed output's fallback buffer), by name, before any is written.
+///
+/// With `--lod-files`, each level's file is written instead of `output` itself
+/// ([`lod::level_path`]).
 pub fn files_written(output: &Path, options: &Options) -> Vec<std::path::PathBuf> {
-    gltf_io::output_files(output, options.compression())
+    if !writes_level_files(options) {
+        return gltf_io::output_files(output, options.compression());
+    }
+    (0..options.lod_levels().len())
+        .flat_map(|k| gltf_io::output_files(&lod::level_path(output, k), options.compression()))
+        .collect()
+}
+
+/// Whether a run writes one file per level of detail instead of one output.
+fn writes_level_files(options: &Options) -> bool {
+    options.lod_files && !options.lod_levels().is_empty()
 }
 
 /// Does everything [`process_file`] does except writing: returns the files it would write
@@ -76,14 +90,24 @@ pub fn encode_file(
     let located = |e: gltf_io::Error| Error::gltf(input, e);
     let mut doc = gltf_io::read(input, &options.read_options()).map_err(located)?;
     let read_s = started.elapsed().as_secs_f64();
-    let mut report = process_document(&mut doc, input, options)?;
+    let (mut report, docs) = if writes_level_files(options) {
+        let (report, docs) = process_document_per_level(&doc, input, options)?;
+        let paths = (0..docs.len()).map(|k| lod::level_path(output, k));
+        (report, docs.into_iter().zip(paths).collect())
+    } else {
+        let report = process_document(&mut doc, input, options)?;
+        (report, vec![(doc, output.to_path_buf())])
+    };
     let encode_start = Instant::now();
-    if let Some(q) = options.quantization() {
-        gltf_io::quantize(&mut doc, &q).map_err(located)?;
-    }
     let write = WriteOptions::new(Some(input.to_path_buf()), options.overwrite_input)
         .with_compression(options.compression());
-    let files = gltf_io::encode(&doc, output, &write).map_err(|e| Error::gltf(output, e))?;
+    let mut files = gltf_io::Files::new();
+    for (mut doc, path) in docs {
+        if let Some(q) = options.quantization() {
+            gltf_io::quantize(&mut doc, &q).map_err(located)?;
+        }
+        files.extend(gltf_io::encode(&doc, &path, &write).map_err(|e| Error::gltf(&path, e))?);
+    }
     report.times.read = read_s;
     report.times.write += encode_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
@@ -116,21 +140,66 @@ fn file_size(path: &Path) -> u64 {
 }
 
 /// Replaces every triangle primitive of `doc` (read from `asset`, which names it in messages
-/// and locates its sidecar) by its tessellated surface.
+/// and locates its sidecar) by its tessellated surface. With a LOD chain the finest level
+/// replaces them and the coarser ones are added as meshes on nodes linked by `MSFT_lod`
+/// (see [`lod::store_with_msft_lod`]).
 pub fn process_document(
     doc: &mut Document,
     asset: &Path,
     options: &Options,
 ) -> Result<FileReport, Error> {
+    let (mut report, outputs) = smooth_document(doc, asset, options)?;
+    let store_start = Instant::now();
+    for out in outputs {
+        report.add_mesh(lod::store_with_msft_lod(doc, out?, asset)?);
+    }
+    // Storing the new arrays in the document's buffer is the first half of writing.
+    report.times.write = store_start.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// [`process_document`] for `--lod-files`: one document per level of the options' LOD chain,
+/// finest first, each with every mesh at that level; the meshes are smoothed once.
+pub fn process_document_per_level(
+    doc: &Document,
+    asset: &Path,
+    options: &Options,
+) -> Result<(FileReport, Vec<Document>), Error> {
+    let (mut report, outputs) = smooth_document(doc, asset, options)?;
+    let store_start = Instant::now();
+    let mut outputs: Vec<MeshOutput> = outputs.into_iter().collect::<Result<_, _>>()?;
+    let mut docs = Vec::new();
+    for level in 0..options.lod_levels().len().max(1) {
+        let mut copy = doc.clone();
+        for out in &mut outputs {
+            lod::store_level(&mut copy, out, level, asset)?;
+        }
+        docs.push(copy);
+    }
+    for out in outputs {
+        report.add_mesh(out.report);
+    }
+    report.times.write = store_start.elapsed().as_secs_f64();
+    Ok((report, docs))
+}
+
+/// Smooths every mesh of `doc` (the document is only read), in parallel, results in file
+/// order; each mesh under its own options (the sidecar's density keys over `options`).
+fn smooth_document(
+    doc: &Document,
+    asset: &Path,
+    options: &Options,
+) -> Result<(FileReport, Vec<Result<MeshOutput, Error>>), Error> {
     let sharpness = asset_sharpness(doc, asset, options)?;
     let level = sharpness.level().unwrap_or(options.level);
 
     // Refuse what would not fit before decoding or allocating any of it. Per-edge counts are
     // known only once a mesh's surface is built: that mesh is checked then, here its floor.
-    let floor = if options.adaptive() { 1 } else { level };
+    let varies = options.adaptive() || !options.lod_levels().is_empty() || sharpness.sets_density();
+    let floor = if varies { 1 } else { level };
     check_output_size(doc, floor, options, asset)?;
 
-    // Decode every triangle primitive first (the document is only read here).
+    // Decode every triangle primitive first.
     let decode_start = Instant::now();
     let inputs = mesh_inputs(doc, asset)?;
     let decode_s = decode_start.elapsed().as_secs_f64();
@@ -138,7 +207,11 @@ pub fn process_document(
     // The meshes are independent: smooth them in parallel, collect in file order.
     let outputs: Vec<Result<MeshOutput, Error>> = inputs
         .par_iter()
-        .map(|m| mesh_job::smooth_mesh(m, &sharpness, level, options, asset))
+        .map(|m| {
+            let mesh_options = sharpness.mesh_options(m.mesh, options);
+            let mesh_level = mesh_options.level;
+            mesh_job::smooth_mesh(m, &sharpness, mesh_level, &mesh_options, asset)
+        })
         .collect();
 
     let mut report = FileReport {
@@ -146,18 +219,7 @@ pub fn process_document(
         ..FileReport::default()
     };
     report.times.decode = decode_s;
-    let store_start = Instant::now();
-    for out in outputs {
-        let out = out?;
-        for (prim, data) in out.primitives {
-            gltf_io::replace_primitive_owned(doc, out.report.mesh, prim, data)
-                .map_err(|e| Error::gltf(asset, e))?;
-        }
-        report.add_mesh(out.report);
-    }
-    // Storing the new arrays in the document's buffer is the first half of writing.
-    report.times.write = store_start.elapsed().as_secs_f64();
-    Ok(report)
+    Ok((report, outputs))
 }
 
 /// Every mesh with triangle primitives, decoded, in file order.
