@@ -482,7 +482,9 @@ impl Options {
             if !ok {
                 let expected = match key {
                     "lod" => "more than 0 world units",
-                    "lod_relative" => "more than 0 and at most 1, a fraction of the bounding-box diagonal",
+                    "lod_relative" => {
+                        "more than 0 and at most 1, a fraction of the bounding-box diagonal"
+                    }
                     _ => "at least 1 triangle",
                 };
                 return Err((key, format!("level {i} is {v} (expected {expected})")));

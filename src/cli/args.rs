@@ -57,16 +57,31 @@ pub struct Args {
     /// Write a LOD chain: one level of detail per chord tolerance in world units, comma-separated
     /// (e.g. 0.001,0.004,0.016), sharing one surface set-up; coarser levels are listed on each
     /// node with MSFT_lod (loaders without it show the finest) [default: off]
-    #[arg(long, value_name = "E,E,..", value_delimiter = ',', help_heading = "Level of detail")]
+    #[arg(
+        long,
+        value_name = "E,E,..",
+        value_delimiter = ',',
+        help_heading = "Level of detail"
+    )]
     pub lod: Vec<f64>,
 
     /// A LOD chain from tolerances relative to each mesh's bounding-box diagonal (e.g.
     /// 0.0005,0.002,0.008)
-    #[arg(long, value_name = "F,F,..", value_delimiter = ',', help_heading = "Level of detail")]
+    #[arg(
+        long,
+        value_name = "F,F,..",
+        value_delimiter = ',',
+        help_heading = "Level of detail"
+    )]
     pub lod_relative: Vec<f64>,
 
     /// A LOD chain from triangle budgets per mesh (e.g. 20000,5000,1200)
-    #[arg(long, value_name = "N,N,..", value_delimiter = ',', help_heading = "Level of detail")]
+    #[arg(
+        long,
+        value_name = "N,N,..",
+        value_delimiter = ',',
+        help_heading = "Level of detail"
+    )]
     pub lod_budget: Vec<u64>,
 
     /// Write each LOD level to its own file, OUTPUT's stem with _LOD0, _LOD1 ... (the suffix

@@ -24,7 +24,14 @@ const SHARED_NODE_EXTENSIONS: [&str; 1] = ["EXT_mesh_gpu_instancing"];
 
 /// Node properties a LOD node shares with its finest node: its transform, its skin (a skinned
 /// level must follow the same joints) and its morph weights (every level carries the targets).
-const SHARED_NODE_KEYS: [&str; 6] = ["translation", "rotation", "scale", "matrix", "skin", "weights"];
+const SHARED_NODE_KEYS: [&str; 6] = [
+    "translation",
+    "rotation",
+    "scale",
+    "matrix",
+    "skin",
+    "weights",
+];
 
 /// `name_LOD3`, the suffix Unity's and Unreal's importers group levels by; unnamed: `LOD3`.
 pub fn lod_name(name: Option<&str>, level: usize) -> String {
@@ -41,17 +48,23 @@ pub fn nodes_using(doc: &Document, mesh: usize) -> Vec<usize> {
         .collect()
 }
 
-/// Why node `node` cannot carry levels of detail, if it cannot: a node with children (a LOD
-/// node stands in for the node's whole subtree, and a glTF node has one parent, so the
-/// children could not be shared), or one that already has `MSFT_lod`.
+/// Why node `node` cannot carry levels of detail, if it cannot: an unskinned node with
+/// children (a viewer may put a LOD node in place of the node's whole subtree, and a glTF node
+/// has one parent, so the children could not be shared), or one that has `MSFT_lod` already.
+///
+/// A skinned node's children are allowed: they are usually its skeleton, which the LOD node
+/// reaches through the same `skin` (joints are named by index, not by parenthood), and a skinned
+/// mesh is placed by its joints, not by its node's transform or place in the tree.
 pub fn why_not_linkable(doc: &Document, node: usize) -> Option<&'static str> {
     let raw = doc.raw.pointer(&format!("/nodes/{node}"))?;
-    if raw
+    let has_children = raw
         .get("children")
         .and_then(Value::as_array)
-        .is_some_and(|c| !c.is_empty())
-    {
-        return Some("it has children, which a LOD node (standing in for its subtree) could not share");
+        .is_some_and(|c| !c.is_empty());
+    if has_children && raw.get("skin").is_none() {
+        return Some(
+            "it has children and no skin, and a LOD node (which may stand in for the whole subtree) could not share them",
+        );
     }
     if raw.pointer(&format!("/extensions/{MSFT_LOD}")).is_some() {
         return Some("it has levels of detail already");
@@ -114,7 +127,10 @@ pub fn link_levels(
     // Unnamed nodes take their level names from the mesh's, so engines can still group them.
     let mesh_name = doc
         .raw
-        .pointer(&format!("/meshes/{}/name", meshes.first().copied().unwrap_or(0)))
+        .pointer(&format!(
+            "/meshes/{}/name",
+            meshes.first().copied().unwrap_or(0)
+        ))
         .and_then(Value::as_str)
         .and_then(|n| n.strip_suffix("_LOD1"))
         .map(str::to_owned);

@@ -206,7 +206,11 @@ impl AssetSharpness {
 
     /// The options mesh `mesh` is tessellated with: `options` (flags, folder config,
     /// `--config`) under the sidecar's top-level density keys, under the mesh section's.
-    pub fn mesh_options(&self, mesh: usize, options: &crate::options::Options) -> crate::options::Options {
+    pub fn mesh_options(
+        &self,
+        mesh: usize,
+        options: &crate::options::Options,
+    ) -> crate::options::Options {
         let Some(sc) = &self.sidecar else {
             return options.clone();
         };
@@ -221,7 +225,10 @@ impl AssetSharpness {
     pub fn sets_density(&self) -> bool {
         self.sidecar.as_ref().is_some_and(|sc| {
             sc.density != DensityKeys::default()
-                || sc.meshes.iter().any(|m| m.density != DensityKeys::default())
+                || sc
+                    .meshes
+                    .iter()
+                    .any(|m| m.density != DensityKeys::default())
         })
     }
 

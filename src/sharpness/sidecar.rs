@@ -299,7 +299,14 @@ fn density_keys(
     }
     if let Some(v) = raw.tolerance {
         let tolerance = *v.get_ref();
-        check(v.span(), "tolerance", Options { tolerance, ..Options::default() })?;
+        check(
+            v.span(),
+            "tolerance",
+            Options {
+                tolerance,
+                ..Options::default()
+            },
+        )?;
         keys.tolerance = Some(tolerance);
     }
     if let Some(v) = raw.relative_tolerance {
