@@ -2,7 +2,7 @@
 //! linked by `MSFT_lod` from every node that shows the mesh, or one document per level
 //! (`--lod-files`), and the screen-coverage hints that say when a viewer may switch.
 //!
-//! It deliberately makes no geometry: [`super::mesh_job`] tessellates every level from one
+//! It deliberately makes no geometry: the mesh job tessellates every level from one
 //! surface set-up, this module only stores what it made.
 
 use std::path::{Path, PathBuf};

@@ -30,7 +30,7 @@ pub struct Sidecar {
 }
 
 /// The density keys of one sidecar block (the top level or a mesh section), each range-checked
-/// by the rule of its flag ([`crate::options::Options::validate`], [`check_level`]).
+/// by the rule of its flag ([`crate::options::Options::validate`]; `level` as `--level`).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct DensityKeys {
     pub level: Option<u32>,
