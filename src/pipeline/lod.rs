@@ -92,16 +92,23 @@ pub fn store_with_msft_lod(
         ));
         return Ok(report);
     }
-    let mut meshes = Vec::with_capacity(lods.len());
+    let mut meshes: Vec<usize> = Vec::with_capacity(lods.len());
     for (k, level) in lods.into_iter().enumerate() {
-        let copy = lod::add_mesh_copy(doc, mesh, k + 1).map_err(located)?;
-        for (prim, data) in level {
-            gltf_io::replace_primitive_owned(doc, copy, prim, data).map_err(located)?;
-        }
+        let shown = match level {
+            Some(level) => {
+                let copy = lod::add_mesh_copy(doc, mesh, k + 1).map_err(located)?;
+                for (prim, data) in level {
+                    gltf_io::replace_primitive_owned(doc, copy, prim, data).map_err(located)?;
+                }
+                copy
+            }
+            // The same output as the level before: its node shows that level's mesh.
+            None => meshes.last().copied().unwrap_or(mesh),
+        };
         if let Some(r) = report.lod.get_mut(k + 1) {
-            r.mesh = Some(copy);
+            r.mesh = Some(shown);
         }
-        meshes.push(copy);
+        meshes.push(shown);
     }
     let errors: Vec<f64> = report
         .lod
@@ -123,13 +130,29 @@ pub fn store_level(
     level: usize,
     asset: &Path,
 ) -> Result<(), Error> {
+    // A level the same as the one before is that level's arrays again; levels are stored
+    // finest first, so the arrays are copied while still held and moved out last.
+    let repeated = out.lods.get(level).is_some_and(Option::is_none);
     let data = if level == 0 {
-        std::mem::take(&mut out.primitives)
+        if repeated {
+            out.primitives.clone()
+        } else {
+            std::mem::take(&mut out.primitives)
+        }
     } else {
-        out.lods
-            .get_mut(level - 1)
-            .map(std::mem::take)
-            .unwrap_or_default()
+        let mut source = level - 1;
+        while source > 0 && out.lods[source].is_none() {
+            source -= 1;
+        }
+        let held = match &mut out.lods[source] {
+            Some(held) => held,
+            None => &mut out.primitives,
+        };
+        if repeated {
+            held.clone()
+        } else {
+            std::mem::take(held)
+        }
     };
     for (prim, data) in data {
         gltf_io::replace_primitive_owned(doc, out.report.mesh, prim, data)

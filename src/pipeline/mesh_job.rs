@@ -58,8 +58,9 @@ pub struct MeshInput {
 pub struct MeshOutput {
     /// (primitive index, new data), in file order: the finest level.
     pub primitives: Vec<(usize, PrimitiveData)>,
-    /// The coarser levels of a LOD chain, finest first, each as `primitives` is.
-    pub lods: Vec<Vec<(usize, PrimitiveData)>>,
+    /// The coarser levels of a LOD chain, finest first, each as `primitives` is; `None` where
+    /// a level's counts equal the level before's (the same output, made and written once).
+    pub lods: Vec<Option<Vec<(usize, PrimitiveData)>>>,
     /// Counts, timings, continuity, warnings.
     pub report: MeshReport,
     /// The diagonal of the mesh's bounding box, which the LOD chain's coverage hints scale by.
@@ -182,9 +183,29 @@ pub fn smooth_mesh(
     };
     let mut primitives = Vec::new();
     let mut lods = Vec::new();
+    let mut previous_counts = None;
     for (k, level_options) in levels.iter().enumerate() {
         let tess_start = Instant::now();
         let density = Density::choose(level_options, level, &mesh, &topo, surface.as_ref());
+        let counts = match &density {
+            Density::Counts { counts, .. } => Some(counts.clone()),
+            Density::Level(_) => None,
+        };
+        if k > 0 && counts.is_some() && counts == previous_counts {
+            // A looser tolerance (or a larger budget) that changes no count: a flat mesh at one
+            // segment per edge, say. The level before is this level.
+            let mut same = report.lod[k - 1].clone();
+            same.level = k;
+            if let Density::Counts { target, .. } = &density {
+                same.figures.tolerance = *target;
+            }
+            same.triangle_budget =
+                (level_options.triangle_budget > 0).then_some(level_options.triangle_budget);
+            report.lod.push(same);
+            lods.push(None);
+            continue;
+        }
+        previous_counts = counts;
         let planned = density.triangle_count(&mesh, &topo);
         if planned > options.max_output_triangles {
             return Err(Error::limit(
@@ -265,7 +286,7 @@ pub fn smooth_mesh(
             report.adaptive = figures;
             primitives = level_primitives;
         } else {
-            lods.push(level_primitives);
+            lods.push(Some(level_primitives));
         }
     }
     // The surface holds about 1 kB per input triangle; it is freed once every level is made.

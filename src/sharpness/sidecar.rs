@@ -436,3 +436,33 @@ impl LineIndex {
         self.starts.partition_point(|&s| s <= offset)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::options::Options;
+
+    /// A block that sets any density key decides its scope alone; `max_segments` goes on its
+    /// own; a block with none changes nothing.
+    #[test]
+    fn density_blocks_replace_the_density_they_set() {
+        let text = "tolerance = 0.01\nmax_segments = 8\n[mesh.0]\nlevel = 3\n[mesh.1]\nh = 0.1\n";
+        let sc = Sidecar::parse(Path::new("s.toml"), text).unwrap();
+        let flags = Options {
+            relative_tolerance: 0.5,
+            triangle_budget: 100,
+            ..Options::default()
+        };
+        let asset = sc.density.apply(flags.clone());
+        assert_eq!(
+            (asset.tolerance, asset.relative_tolerance, asset.triangle_budget),
+            (0.01, 0.0, 0)
+        );
+        assert_eq!(asset.max_segments, 8);
+        let uniform = sc.meshes[0].density.apply(asset.clone());
+        assert_eq!(uniform.level, 3);
+        assert!(!uniform.adaptive());
+        assert_eq!(uniform.max_segments, 8);
+        assert_eq!(sc.meshes[1].density.apply(asset.clone()), asset);
+    }
+}

@@ -230,6 +230,24 @@ fn a_chain_of_three_is_coarser_each_level_within_tolerance_watertight_and_linked
         .iter()
         .all(|n| n.get("children").is_none()));
 
+    // What such a loader sees is exactly a one-level run at the finest tolerance.
+    let mut single = Options::default();
+    single.tolerance = TOLERANCES[0];
+    let one = dir.path().join("one.gltf");
+    process_file(&input, &one, &single).unwrap();
+    let arrays = |path: &Path| {
+        let doc = gltf_io::read(path, &ReadOptions::default()).unwrap();
+        let data = doc.read_primitive(0, 0).unwrap();
+        (
+            data.positions("test").unwrap().to_vec(),
+            data.indices.clone(),
+        )
+    };
+    assert!(
+        arrays(&one) == arrays(&out("1")),
+        "level 0 differs from a one-level run"
+    );
+
     if let Some(verdicts) = corpus::validate(&[out("1").as_path()]) {
         let v = &verdicts[&out("1")];
         assert_eq!(v.errors, 0, "{:?}", v.codes);
@@ -416,7 +434,7 @@ fn real_fixtures_skins_morphs_instancing_budgets() {
     };
     let dir = corpus::temp_dir();
     let mut written = Vec::new();
-    let (mut skinned, mut instanced, mut morphed) = (0, 0, 0);
+    let (mut skinned, mut instanced, mut morphed, mut same_shared) = (0, 0, 0, 0);
     for name in [
         "SkinnedCylinder",
         "AnimatedMorphCube",
@@ -449,6 +467,11 @@ fn real_fixtures_skins_morphs_instancing_budgets() {
             // Within its budget, or at the input's own triangles when the budget is below them.
             let input: usize = mesh.primitives.iter().map(|p| p.triangles_in).sum();
             assert!(levels[1].triangles <= 600.max(input), "{name}");
+            // A level with the counts of the one before is written once and shown twice.
+            if levels[0].triangles == levels[1].triangles && levels[1].mesh.is_some() {
+                assert_eq!(levels[1].mesh, levels[0].mesh, "{name}");
+                same_shared += 1;
+            }
             let Some(coarse) = levels[1].mesh else {
                 assert!(
                     !mesh.warnings.is_empty(),
