@@ -455,7 +455,11 @@ mod tests {
         };
         let asset = sc.density.apply(flags.clone());
         assert_eq!(
-            (asset.tolerance, asset.relative_tolerance, asset.triangle_budget),
+            (
+                asset.tolerance,
+                asset.relative_tolerance,
+                asset.triangle_budget
+            ),
             (0.01, 0.0, 0)
         );
         assert_eq!(asset.max_segments, 8);

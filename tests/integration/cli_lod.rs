@@ -313,6 +313,15 @@ fn lod_files_are_named_per_level_and_checked() {
         }
     }
 
+    // A depfile names every level file as what the run makes.
+    assert!(run(&["--depfile", "--force"]).status.success());
+    let depfile = std::fs::read_to_string(dir.path().join("out").join("cyl.glb.d")).unwrap();
+    let targets = depfile.split(':').next().unwrap();
+    assert!(
+        targets.contains("cyl_LOD0.glb") && targets.contains("cyl_LOD1.glb"),
+        "{depfile}"
+    );
+
     assert!(run(&["--check"]).status.success());
     std::fs::remove_file(level(1)).unwrap();
     let stale = run(&["--check"]);
