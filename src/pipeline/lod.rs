@@ -19,7 +19,7 @@ pub const COVERAGE_SCREEN_PIXELS: f64 = 1080.0;
 ///
 /// Value `k` is the smallest screen coverage (the mesh's bounding-box diagonal as a fraction of
 /// the screen's height) at which level `k` is still drawn; below it level `k + 1` is. A level's
-/// measured chord error `e` covers `coverage · P · e / D` pixels on a screen of `P` =
+/// chord error `e` (its target tolerance, which bounds it) covers `coverage · P · e / D` pixels on a screen of `P` =
 /// [`COVERAGE_SCREEN_PIXELS`] pixels for a diagonal `D`, so level `k + 1` takes over once its
 /// error is at most one pixel: `value[k] = min(1, D / (P · e[k + 1]))`, kept non-increasing. The
 /// last value is 0: the coarsest level is drawn down to nothing, never culled.
@@ -110,11 +110,10 @@ pub fn store_with_msft_lod(
         }
         meshes.push(shown);
     }
-    let errors: Vec<f64> = report
-        .lod
-        .iter()
-        .map(|l| l.figures.chord_error.unwrap_or(l.figures.tolerance))
-        .collect();
+    // The targets, not the measured errors: the output must not depend on whether a report
+    // is written, and each level's error is at most its target, so the hints err towards
+    // keeping the finer level.
+    let errors: Vec<f64> = report.lod.iter().map(|l| l.figures.tolerance).collect();
     let coverage = screen_coverage(diagonal, &errors);
     for node in nodes {
         lod::link_levels(doc, node, &meshes, &coverage).map_err(located)?;

@@ -219,13 +219,13 @@ pub fn smooth_mesh(
         let mut dense =
             density.tessellate(&mesh, &topo, &params.effective, surface.as_ref(), &groups);
         report.times.tessellate += tess_start.elapsed().as_secs_f64();
-        // A chain's report gives each level's reached tolerance, so it is always measured.
+        // Measured for the report only, as for one level: the output never depends on it.
         let figures = density.figures(
             &topo,
             surface.as_ref(),
             &groups,
             &dense,
-            options.report_figures || is_chain,
+            options.report_figures,
         );
         stop_if_cancelled(options, asset)?;
 
