@@ -92,14 +92,6 @@ fn lod_options() -> Options {
     o
 }
 
-fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap()
-        .install(f)
-}
-
 fn json_of(gltf_path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(gltf_path).unwrap()).unwrap()
 }
@@ -139,8 +131,8 @@ fn a_chain_of_three_is_coarser_each_level_within_tolerance_watertight_and_linked
         std::fs::create_dir_all(dir.path().join(tag)).unwrap();
     }
     let report: FileReport =
-        in_pool(1, || process_file(&input, &out("1"), &lod_options())).unwrap();
-    in_pool(2, || process_file(&input, &out("2"), &lod_options())).unwrap();
+        support::in_pool(1, || process_file(&input, &out("1"), &lod_options())).unwrap();
+    support::in_pool(2, || process_file(&input, &out("2"), &lod_options())).unwrap();
     for ext in ["gltf", "bin"] {
         let bytes = |tag: &str| std::fs::read(out(tag).with_extension(ext)).unwrap();
         assert!(
