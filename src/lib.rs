@@ -29,7 +29,9 @@
 //! - [`optimize`]: meshoptimizer's vertex cache and fetch ordering.
 //! - [`options`]: the resolved settings that flow down through every stage.
 //! - [`pipeline`]: one file in, one file out; [`pipeline::process_document`] joins the stages;
-//!   each fallback a stage takes reaches its report as a typed [`pipeline::Warning`].
+//!   each fallback a stage takes reaches its report as a typed [`pipeline::Warning`];
+//!   [`pipeline::lod`] stores a LOD chain (`MSFT_lod` meshes and nodes via [`gltf_io::lod`], or
+//!   one document per level).
 //! - [`render`]: pictures of any document on the CPU (shaded, zebra, flat, and the input's
 //!   edges coloured by h), side by side with one camera, as PNG.
 //!

@@ -21,6 +21,8 @@ pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 0.0;
 pub const DEFAULT_TRIANGLE_BUDGET: u64 = 0;
 /// Default cap on segments per edge (and inner level) under a tolerance or budget.
 pub const DEFAULT_MAX_SEGMENTS: u32 = MAX_LEVEL;
+/// Most levels in a LOD chain (`--lod`, `--lod-relative`, `--lod-budget`).
+pub const MAX_LOD_LEVELS: usize = 8;
 /// Default blend width `h`, in the paper's reference triangle (0.6 of the maximum).
 pub const DEFAULT_H: f64 = 0.212;
 /// Largest blend width: √2/4, a quarter of the reference triangle's side (the surface's one
@@ -178,6 +180,18 @@ pub struct Options {
     /// Cap on segments per edge under a tolerance or budget. Default: [`DEFAULT_MAX_SEGMENTS`];
     /// range 1..=[`MAX_LEVEL`].
     pub max_segments: u32,
+    /// A LOD chain: one level of detail per chord tolerance in world units (any order; the
+    /// finest is written where the mesh was). Empty is off. At most one of `lod`,
+    /// `lod_relative`, `lod_budget`; with one, `level`, the tolerances and the budget are not
+    /// used. Default: none.
+    pub lod: Vec<f64>,
+    /// A LOD chain from tolerances relative to each mesh's bounding-box diagonal. Default: none.
+    pub lod_relative: Vec<f64>,
+    /// A LOD chain from triangle budgets per mesh. Default: none.
+    pub lod_budget: Vec<u64>,
+    /// Write the LOD chain as one file per level (`<output stem>_LOD<k>.<ext>`) instead of one
+    /// file with `MSFT_lod`. Default: `false`.
+    pub lod_files: bool,
     /// Blend width for edges with no other source. Default: [`DEFAULT_H`]; range 0..=[`MAX_H`].
     pub h: f64,
     /// Crease angle in degrees. Default: [`DEFAULT_CREASE_ANGLE`]; range 0..=180.
@@ -255,6 +269,10 @@ impl Default for Options {
             relative_tolerance: DEFAULT_RELATIVE_TOLERANCE,
             triangle_budget: DEFAULT_TRIANGLE_BUDGET,
             max_segments: DEFAULT_MAX_SEGMENTS,
+            lod: Vec::new(),
+            lod_relative: Vec::new(),
+            lod_budget: Vec::new(),
+            lod_files: false,
             h: DEFAULT_H,
             crease_angle: DEFAULT_CREASE_ANGLE,
             profile: DEFAULT_PROFILE,
@@ -287,6 +305,10 @@ pub struct ConfigFile {
     pub relative_tolerance: Option<f64>,
     pub triangle_budget: Option<u64>,
     pub max_segments: Option<u32>,
+    pub lod: Option<Vec<f64>>,
+    pub lod_relative: Option<Vec<f64>>,
+    pub lod_budget: Option<Vec<u64>>,
+    pub lod_files: Option<bool>,
     pub h: Option<f64>,
     pub crease_angle: Option<f64>,
     pub profile: Option<Profile>,
@@ -330,8 +352,15 @@ impl ConfigFile {
 impl Options {
     /// These options with every key `config` sets replaced.
     pub fn overlay(mut self, config: &ConfigFile) -> Self {
+        // The LOD lists are one setting: a layer that sets any of them replaces all three, so
+        // that `--lod` overrides a folder's `lod_budget` instead of clashing with it.
+        if config.lod.is_some() || config.lod_relative.is_some() || config.lod_budget.is_some() {
+            self.lod.clear();
+            self.lod_relative.clear();
+            self.lod_budget.clear();
+        }
         macro_rules! take {
-            ($($f:ident),*) => { $( if let Some(v) = config.$f { self.$f = v; } )* };
+            ($($f:ident),*) => { $( if let Some(v) = &config.$f { self.$f = v.clone(); } )* };
         }
         take!(
             level,
@@ -339,6 +368,10 @@ impl Options {
             relative_tolerance,
             triangle_budget,
             max_segments,
+            lod,
+            lod_relative,
+            lod_budget,
+            lod_files,
             h,
             crease_angle,
             profile,
@@ -397,10 +430,105 @@ impl Options {
                 format!("is {} (expected 1 to {MAX_LEVEL})", self.max_segments),
             );
         }
+        self.validate_lod().or_else(|(key, what)| err(key, what))?;
         if self.max_output_triangles == 0 {
             return err("max_output_triangles", "is 0 (expected at least 1)".into());
         }
         Ok(())
+    }
+
+    /// The LOD lists' rules: one list at most, each value in the range of its single-level
+    /// setting (and non-zero: a level that is off is no level), no value twice, at most
+    /// [`MAX_LOD_LEVELS`] levels.
+    fn validate_lod(&self) -> Result<(), (&'static str, String)> {
+        let lists = [
+            ("lod", self.lod.len()),
+            ("lod_relative", self.lod_relative.len()),
+            ("lod_budget", self.lod_budget.len()),
+        ];
+        let set: Vec<&str> = lists.iter().filter(|l| l.1 > 0).map(|l| l.0).collect();
+        if let [first, second, ..] = set.as_slice() {
+            return Err((
+                second,
+                format!("is set with {first} (expected one LOD list: tolerances, relative tolerances or budgets)"),
+            ));
+        }
+        if let Some(&(key, n)) = lists.iter().find(|l| l.1 > MAX_LOD_LEVELS) {
+            return Err((
+                key,
+                format!("has {n} levels (expected 1 to {MAX_LOD_LEVELS})"),
+            ));
+        }
+        let values: Vec<f64> = self
+            .lod
+            .iter()
+            .chain(&self.lod_relative)
+            .copied()
+            .chain(self.lod_budget.iter().map(|&b| b as f64))
+            .collect();
+        if self.lod_files && set.is_empty() {
+            return Err((
+                "lod_files",
+                "is set without a LOD list (expected lod, lod_relative or lod_budget too)".into(),
+            ));
+        }
+        let key = set.first().copied().unwrap_or("lod");
+        for (i, &v) in values.iter().enumerate() {
+            let ok = match key {
+                "lod" => v > 0.0 && v.is_finite(),
+                "lod_relative" => v > 0.0 && v <= 1.0,
+                _ => v >= 1.0,
+            };
+            if !ok {
+                let expected = match key {
+                    "lod" => "more than 0 world units",
+                    "lod_relative" => {
+                        "more than 0 and at most 1, a fraction of the bounding-box diagonal"
+                    }
+                    _ => "at least 1 triangle",
+                };
+                return Err((key, format!("level {i} is {v} (expected {expected})")));
+            }
+            if values[..i].contains(&v) {
+                return Err((
+                    key,
+                    format!("lists {v} twice (expected one value per level)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The options of each level of the LOD chain, finest first (tolerances ascending, budgets
+    /// descending): these options with the level's tolerance or budget and no other. Empty
+    /// without a LOD list.
+    pub fn lod_levels(&self) -> Vec<Options> {
+        let level = |tolerance: f64, relative_tolerance: f64, triangle_budget: u64| Options {
+            tolerance,
+            relative_tolerance,
+            triangle_budget,
+            lod: Vec::new(),
+            lod_relative: Vec::new(),
+            lod_budget: Vec::new(),
+            ..self.clone()
+        };
+        let ascending = |list: &[f64]| {
+            let mut v = list.to_vec();
+            v.sort_by(f64::total_cmp);
+            v
+        };
+        let mut budgets = self.lod_budget.clone();
+        budgets.sort_unstable_by(|a, b| b.cmp(a));
+        ascending(&self.lod)
+            .into_iter()
+            .map(|t| level(t, 0.0, 0))
+            .chain(
+                ascending(&self.lod_relative)
+                    .into_iter()
+                    .map(|r| level(0.0, r, 0)),
+            )
+            .chain(budgets.into_iter().map(|b| level(0.0, 0.0, b)))
+            .collect()
     }
 
     /// Whether each edge gets its own segment count (a tolerance or a budget is set).

@@ -54,6 +54,41 @@ pub struct Args {
     #[arg(long, value_name = "N", help_heading = "Surface")]
     pub max_segments: Option<u32>,
 
+    /// Write a LOD chain: one level of detail per chord tolerance in world units, comma-separated
+    /// (e.g. 0.001,0.004,0.016), sharing one surface set-up; coarser levels are listed on each
+    /// node with MSFT_lod (loaders without it show the finest) [default: off]
+    #[arg(
+        long,
+        value_name = "E,E,..",
+        value_delimiter = ',',
+        help_heading = "Level of detail"
+    )]
+    pub lod: Vec<f64>,
+
+    /// A LOD chain from tolerances relative to each mesh's bounding-box diagonal (e.g.
+    /// 0.0005,0.002,0.008)
+    #[arg(
+        long,
+        value_name = "F,F,..",
+        value_delimiter = ',',
+        help_heading = "Level of detail"
+    )]
+    pub lod_relative: Vec<f64>,
+
+    /// A LOD chain from triangle budgets per mesh (e.g. 20000,5000,1200)
+    #[arg(
+        long,
+        value_name = "N,N,..",
+        value_delimiter = ',',
+        help_heading = "Level of detail"
+    )]
+    pub lod_budget: Vec<u64>,
+
+    /// Write each LOD level to its own file, OUTPUT's stem with _LOD0, _LOD1 ... (the suffix
+    /// Unity's and Unreal's importers group by), instead of one file with MSFT_lod
+    #[arg(long, help_heading = "Level of detail")]
+    pub lod_files: bool,
+
     /// Blend width h of edges without their own, 0 to 0.3536 [default: 0.212]
     #[arg(long, help_heading = "Surface")]
     pub h: Option<f64>,
@@ -396,6 +431,10 @@ impl Args {
             relative_tolerance: self.relative_tolerance,
             triangle_budget: self.triangle_budget,
             max_segments: self.max_segments,
+            lod: (!self.lod.is_empty()).then(|| self.lod.clone()),
+            lod_relative: (!self.lod_relative.is_empty()).then(|| self.lod_relative.clone()),
+            lod_budget: (!self.lod_budget.is_empty()).then(|| self.lod_budget.clone()),
+            lod_files: self.lod_files.then_some(true),
             h: self.h,
             crease_angle: self.crease_angle,
             profile: self.profile.map(|p| match p {

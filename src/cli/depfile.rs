@@ -53,15 +53,29 @@ fn write_one(job: &Job, options: &Options, config: Option<&Path>) -> Result<(), 
         .map(PathBuf::as_path)
         .filter(|p| p.exists())
         .collect();
-    let text = render(&job.output, &present)
+    // With `--lod-files` the level files are what is made, and what Make and Ninja check.
+    let levels = options.lod_levels().len();
+    let targets: Vec<PathBuf> = if options.lod_files && levels > 0 {
+        (0..levels)
+            .map(|k| g2tess::pipeline::lod::level_path(&job.output, k))
+            .collect()
+    } else {
+        vec![job.output.clone()]
+    };
+    let targets: Vec<&Path> = targets.iter().map(PathBuf::as_path).collect();
+    let text = render(&targets, &present)
         .map_err(|e| format!("{}: cannot write the depfile: {e}", file.display()))?;
     g2tess::gltf_io::write::atomic_write(&file, text.as_bytes()).map_err(|e| e.to_string())
 }
 
-/// The depfile text: `target: dep…` with one dependency per continued line, then an empty rule
-/// per dependency after the first.
-pub fn render(target: &Path, deps: &[&Path]) -> Result<String, String> {
-    let mut text = escape(target)?;
+/// The depfile text: `target…: dep…` with one dependency per continued line, then an empty
+/// rule per dependency after the first.
+pub fn render(targets: &[&Path], deps: &[&Path]) -> Result<String, String> {
+    let mut text = targets
+        .iter()
+        .map(|t| escape(t))
+        .collect::<Result<Vec<_>, _>>()?
+        .join(" ");
     text.push(':');
     for dep in deps {
         text.push_str(" \\\n  ");
@@ -135,7 +149,7 @@ mod tests {
             Path::new("a.bin"),
             Path::new("a.g2tess.toml"),
         ];
-        let text = render(Path::new("out/a.gltf"), &deps).unwrap();
+        let text = render(&[Path::new("out/a.gltf")], &deps).unwrap();
         assert_eq!(
             text,
             "out/a.gltf: \\\n  a.gltf \\\n  a.bin \\\n  a.g2tess.toml\n\na.bin:\n\na.g2tess.toml:\n"

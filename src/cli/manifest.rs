@@ -219,7 +219,13 @@ impl Manifests {
 /// inputs, and removing the outputs of a deleted input).
 pub fn written_files(output: &Path) -> Vec<PathBuf> {
     let any = g2tess::gltf_io::Compression::new(true);
-    g2tess::gltf_io::output_files(output, Some(any))
+    let mut files = g2tess::gltf_io::output_files(output, Some(any));
+    // `--lod-files` writes one file per level instead.
+    for level in 0..g2tess::options::MAX_LOD_LEVELS {
+        let path = g2tess::pipeline::lod::level_path(output, level);
+        files.extend(g2tess::gltf_io::output_files(&path, Some(any)));
+    }
+    files
 }
 
 #[cfg(test)]

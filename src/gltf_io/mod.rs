@@ -19,6 +19,7 @@
 //! - [`mod@write`]: `.glb` or `.gltf` + `.bin`, atomically, streamed from the buffers in memory
 //! - [`stream`]: an output written (or compared with disk) while its document is being made
 //! - `compare`: bytes compared with a file in chunks as they are produced (`--check`)
+//! - [`lod`]: coarser levels of detail as new meshes and nodes linked by `MSFT_lod`
 //! - [`files`]: the files an asset reads and the files an output consists of, by name
 //! - `bounds`: accessor `min`/`max`, in parallel
 //! - `buffer_data`: buffers held in the element type they were made in, shared with the writer
@@ -35,6 +36,7 @@ pub mod error;
 pub mod files;
 pub mod glb;
 pub mod json_merge;
+pub mod lod;
 pub mod meshopt_decode;
 pub mod meshopt_encode;
 pub mod primitive;

@@ -141,7 +141,7 @@ impl Density {
 }
 
 /// Length of the diagonal of the bounding box of `mesh`'s positions.
-fn diagonal(mesh: &TriMesh) -> f64 {
+pub(super) fn diagonal(mesh: &TriMesh) -> f64 {
     let Some(&first) = mesh.positions.first() else {
         return 0.0;
     };

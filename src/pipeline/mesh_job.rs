@@ -16,7 +16,7 @@ use super::density::Density;
 use super::error::Error;
 use super::morph;
 use super::primitive_out::{self, Prepared};
-use super::report::{EdgeFigures, MeshReport, PrimitiveReport};
+use super::report::{EdgeFigures, LodReport, MeshReport, PrimitiveReport};
 use super::warning::{merge_target_warnings, Warning};
 use crate::gltf_io::{self, PrimitiveData};
 use crate::mesh::TriMesh;
@@ -57,10 +57,15 @@ pub struct MeshInput {
 /// The replacement primitives of one mesh and what it took.
 #[derive(Debug, Clone)]
 pub struct MeshOutput {
-    /// (primitive index, new data), in file order.
+    /// (primitive index, new data), in file order: the finest level.
     pub primitives: Vec<(usize, PrimitiveData)>,
+    /// The coarser levels of a LOD chain, finest first, each as `primitives` is; `None` where
+    /// a level's counts equal the level before's (the same output, made and written once).
+    pub lods: Vec<Option<Vec<(usize, PrimitiveData)>>>,
     /// Counts, timings, continuity, warnings.
     pub report: MeshReport,
+    /// The diagonal of the mesh's bounding box, which the LOD chain's coverage hints scale by.
+    pub diagonal: f64,
 }
 
 /// A mesh welded and with its h resolved: what every later stage starts from.
@@ -194,68 +199,131 @@ pub fn smooth_mesh(
     report.times.surface = lap(&clock, report.times.sharpness);
     stop_if_cancelled(options, asset)?;
 
-    let tess_start = Instant::now();
-    let density = Density::choose(options, level, &mesh, &topo, surface.as_ref());
-    let planned = density.triangle_count(&mesh, &topo);
-    if planned > options.max_output_triangles {
-        return Err(Error::limit(
-            asset,
-            format!(
-                "mesh {} would get {planned} triangles, over --max-triangles {} (expected a larger tolerance, a --triangle-budget or a larger --max-triangles)",
-                input.mesh, options.max_output_triangles
-            ),
-        ));
-    }
-    let mut dense = density.tessellate(&mesh, &topo, &effective, surface.as_ref(), &groups);
-    report.times.tessellate = tess_start.elapsed().as_secs_f64();
-    report.adaptive = density.figures(
-        &topo,
-        surface.as_ref(),
-        &groups,
-        &dense,
-        options.report_figures,
-    );
-    // The G² surface holds about 240 bytes per input triangle: free it before the attributes are
-    // carried, when the dense mesh is at its largest.
-    drop(surface);
-    stop_if_cancelled(options, asset)?;
+    // One level, or every level of the LOD chain from the one surface: only the counts and
+    // the tessellation are per level.
+    let chain = options.lod_levels();
+    let is_chain = !chain.is_empty();
+    let levels = if chain.is_empty() {
+        vec![options.clone()]
+    } else {
+        chain
+    };
+    let mut primitives = Vec::new();
+    let mut lods = Vec::new();
+    let mut previous_counts = None;
+    // The G² surface holds about 240 bytes per input triangle: freed once the last level is
+    // tessellated, before its attributes are carried, when the dense mesh is at its largest.
+    let mut surface = Some(surface);
+    let last = levels.len() - 1;
+    for (k, level_options) in levels.iter().enumerate() {
+        let tess_start = Instant::now();
+        let live = surface.as_deref().expect("freed after the last level only");
+        let density = Density::choose(level_options, level, &mesh, &topo, live);
+        let counts = match &density {
+            Density::Counts { counts, .. } => Some(counts.clone()),
+            Density::Level(_) => None,
+        };
+        if k > 0 && counts.is_some() && counts == previous_counts {
+            // A looser tolerance (or a larger budget) that changes no count: a flat mesh at one
+            // segment per edge, say. The level before is this level.
+            let mut same = report.lod[k - 1].clone();
+            same.level = k;
+            if let Density::Counts { target, .. } = &density {
+                same.figures.tolerance = *target;
+            }
+            same.triangle_budget =
+                (level_options.triangle_budget > 0).then_some(level_options.triangle_budget);
+            report.lod.push(same);
+            lods.push(None);
+            continue;
+        }
+        previous_counts = counts;
+        let planned = density.triangle_count(&mesh, &topo);
+        if planned > options.max_output_triangles {
+            return Err(Error::limit(
+                asset,
+                format!(
+                    "mesh {} would get {planned} triangles, over --max-triangles {} (expected a larger tolerance, a --triangle-budget or a larger --max-triangles)",
+                    input.mesh, options.max_output_triangles
+                ),
+            ));
+        }
+        let mut dense = density.tessellate(&mesh, &topo, &effective, live, &groups);
+        report.times.tessellate += tess_start.elapsed().as_secs_f64();
+        // Measured for the report only, as for one level: the output never depends on it.
+        let figures = density.figures(&topo, live, &groups, &dense, options.report_figures);
+        if k == last {
+            surface = None;
+        }
+        stop_if_cancelled(options, asset)?;
 
-    // The tessellator already emits cache-friendly bands with vertices in first-use order:
-    // meshoptimizer's vertex cache pass made both figures worse on its output and took longer
-    // than the tessellation (see `optimize.rs`). Only overdraw ordering remains to do.
-    let opt_start = Instant::now();
-    let remaps: Vec<Option<Vec<u32>>> = dense
-        .iter_mut()
-        .map(|d| options.overdraw.then(|| optimize::order_for_overdraw(d)))
-        .collect();
-    report.times.optimize = opt_start.elapsed().as_secs_f64();
+        // The tessellator already emits cache-friendly bands with vertices in first-use order:
+        // meshoptimizer's vertex cache pass made both figures worse on its output and took
+        // longer than the tessellation (see `optimize.rs`). Only overdraw ordering remains.
+        let opt_start = Instant::now();
+        let remaps: Vec<Option<Vec<u32>>> = dense
+            .iter_mut()
+            .map(|d| options.overdraw.then(|| optimize::order_for_overdraw(d)))
+            .collect();
+        report.times.optimize += opt_start.elapsed().as_secs_f64();
 
-    let attr_start = Instant::now();
-    let mut primitives = Vec::with_capacity(prepared.len());
-    let (targets, target_warnings) = morph::targets(
-        &mesh, &topo, &effective, &prepared, &groups, &density, options, &remaps,
-    );
-    let target_warnings = target_warnings
-        .iter()
-        .map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
-        .collect();
-    merge_target_warnings(&mut report.warnings.0, target_warnings);
-    for (k, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
-        report.primitives.push(PrimitiveReport {
-            primitive: input.primitives[k].index,
-            triangles_in: prep.data.indices.len() / 3,
-            vertices_in: prep.source_vertex_count,
-            triangles_out: d.indices.len() / 3,
-            vertices_out: d.positions.len(),
-            cache: options.report_figures.then(|| optimize::cache_figures(&d)),
-        });
-        let data = primitive_out::build(prep, d, groups[k].start as u32, target);
-        refuse_non_finite(&data, input.mesh, input.primitives[k].index, options)
-            .map_err(|e| Error::gltf(asset, e))?;
-        primitives.push((input.primitives[k].index, data));
+        let attr_start = Instant::now();
+        let (targets, target_warnings) = morph::targets(
+            &mesh, &topo, &effective, &prepared, &groups, &density, options, &remaps,
+        );
+        if k == 0 {
+            // Every level's targets are made by the same surfaces: their warnings once.
+            let target_warnings = target_warnings
+                .iter()
+                .map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
+                .collect();
+            merge_target_warnings(&mut report.warnings.0, target_warnings);
+        }
+        let mut level_primitives = Vec::with_capacity(prepared.len());
+        let (mut triangles, mut vertices) = (0, 0);
+        for (j, ((prep, d), target)) in prepared.iter().zip(dense).zip(targets).enumerate() {
+            triangles += d.indices.len() / 3;
+            vertices += d.positions.len();
+            if k == 0 {
+                report.primitives.push(PrimitiveReport {
+                    primitive: input.primitives[j].index,
+                    triangles_in: prep.data.indices.len() / 3,
+                    vertices_in: prep.source_vertex_count,
+                    triangles_out: d.indices.len() / 3,
+                    vertices_out: d.positions.len(),
+                    cache: options.report_figures.then(|| optimize::cache_figures(&d)),
+                });
+            }
+            let data = primitive_out::build(prep, d, groups[j].start as u32, target);
+            refuse_non_finite(&data, input.mesh, input.primitives[j].index, options)
+                .map_err(|e| Error::gltf(asset, e))?;
+            level_primitives.push((input.primitives[j].index, data));
+        }
+        report.times.attributes += attr_start.elapsed().as_secs_f64();
+        if is_chain {
+            report.lod.push(LodReport {
+                level: k,
+                triangle_budget: (level_options.triangle_budget > 0)
+                    .then_some(level_options.triangle_budget),
+                triangles,
+                vertices,
+                figures: figures.clone().unwrap_or_default(),
+                mesh: None,
+            });
+        }
+        if k == 0 {
+            report.adaptive = figures;
+            primitives = level_primitives;
+        } else {
+            lods.push(Some(level_primitives));
+        }
     }
-    report.times.attributes = attr_start.elapsed().as_secs_f64();
-    Ok(MeshOutput { primitives, report })
+    Ok(MeshOutput {
+        primitives,
+        lods,
+        report,
+        diagonal: super::density::diagonal(&mesh),
+    })
 }
 
 /// No output value is ever non-finite: a surface that overflows f32 (coordinates near its

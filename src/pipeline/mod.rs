@@ -11,6 +11,7 @@
 mod checks;
 mod density;
 mod error;
+pub mod lod;
 mod mesh_job;
 mod morph;
 mod primitive_out;
@@ -29,7 +30,7 @@ use crate::sharpness::{explain_rows, AssetSharpness, Defaults, Sidecar};
 pub use density::AdaptiveFigures;
 pub use error::Error;
 pub use mesh_job::{MeshInput, MeshOutput};
-pub use report::{EdgeFigures, FileReport, MeshReport, PrimitiveReport, StageTimes};
+pub use report::{EdgeFigures, FileReport, LodReport, MeshReport, PrimitiveReport, StageTimes};
 pub use warning::{Warning, Warnings};
 
 /// Reads `input`, processes it and writes `output` atomically.
@@ -70,7 +71,9 @@ pub fn check_file(
 
 /// Whether the output under `options` is written as it is produced (see [`process_file`]).
 fn streams(options: &Options) -> bool {
-    options.quantization().is_none() && options.compression().is_none()
+    options.quantization().is_none()
+        && options.compression().is_none()
+        && !writes_level_files(options)
 }
 
 /// Reads `input`, processes it and writes (or compares) `output` mesh by mesh.
@@ -123,8 +126,21 @@ pub fn files_read(asset: &Path, options: &Options) -> Vec<std::path::PathBuf> {
 
 /// Every file that [`process_file`] may write for `output` under `options` (the output, a
 /// `.gltf`'s `.bin`, a compressed output's fallback buffer), by name, before any is written.
+///
+/// With `--lod-files`, each level's file is written instead of `output` itself
+/// ([`lod::level_path`]).
 pub fn files_written(output: &Path, options: &Options) -> Vec<std::path::PathBuf> {
-    gltf_io::output_files(output, options.compression())
+    if !writes_level_files(options) {
+        return gltf_io::output_files(output, options.compression());
+    }
+    (0..options.lod_levels().len())
+        .flat_map(|k| gltf_io::output_files(&lod::level_path(output, k), options.compression()))
+        .collect()
+}
+
+/// Whether a run writes one file per level of detail instead of one output.
+fn writes_level_files(options: &Options) -> bool {
+    options.lod_files && !options.lod_levels().is_empty()
 }
 
 /// Does everything [`process_file`] does except writing, all in memory: returns the files it
@@ -138,14 +154,24 @@ pub fn encode_file(
     let located = |e: gltf_io::Error| Error::gltf(input, e);
     let mut doc = gltf_io::read(input, &options.read_options()).map_err(located)?;
     let read_s = started.elapsed().as_secs_f64();
-    let mut report = process_document(&mut doc, input, options)?;
+    let (mut report, docs) = if writes_level_files(options) {
+        let (report, docs) = process_document_per_level(&doc, input, options)?;
+        let paths = (0..docs.len()).map(|k| lod::level_path(output, k));
+        (report, docs.into_iter().zip(paths).collect())
+    } else {
+        let report = process_document(&mut doc, input, options)?;
+        (report, vec![(doc, output.to_path_buf())])
+    };
     let encode_start = Instant::now();
-    if let Some(q) = options.quantization() {
-        gltf_io::quantize(&mut doc, &q).map_err(located)?;
-    }
     let write = WriteOptions::new(Some(input.to_path_buf()), options.overwrite_input)
         .with_compression(options.compression());
-    let files = gltf_io::encode(&doc, output, &write).map_err(|e| Error::gltf(output, e))?;
+    let mut files = gltf_io::Files::new();
+    for (mut doc, path) in docs {
+        if let Some(q) = options.quantization() {
+            gltf_io::quantize(&mut doc, &q).map_err(located)?;
+        }
+        files.extend(gltf_io::encode(&doc, &path, &write).map_err(|e| Error::gltf(&path, e))?);
+    }
     report.times.read = read_s;
     report.times.write += encode_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
@@ -178,7 +204,9 @@ fn file_size(path: &Path) -> u64 {
 }
 
 /// Replaces every triangle primitive of `doc` (read from `asset`, which names it in messages
-/// and locates its sidecar) by its tessellated surface.
+/// and locates its sidecar) by its tessellated surface. With a LOD chain the finest level
+/// replaces them and the coarser ones are added as meshes on nodes linked by `MSFT_lod`
+/// (see [`lod::store_with_msft_lod`]).
 pub fn process_document(
     doc: &mut Document,
     asset: &Path,
@@ -196,24 +224,7 @@ fn smooth_meshes(
     options: &Options,
     stored: &mut dyn FnMut(&mut Document, bool) -> Result<(), Error>,
 ) -> Result<FileReport, Error> {
-    let sharpness = asset_sharpness(doc, asset, options)?;
-    let level = sharpness.level().unwrap_or(options.level);
-
-    // Refuse what would not fit before decoding or allocating any of it. Per-edge counts are
-    // known only once a mesh's surface is built: that mesh is checked then, here its floor.
-    let floor = if options.adaptive() { 1 } else { level };
-    check_output_size(doc, floor, options, asset)?;
-
-    // Decode every triangle primitive first (the document is only read here).
-    let decode_start = Instant::now();
-    let inputs = mesh_inputs(doc, asset)?;
-    let decode_s = decode_start.elapsed().as_secs_f64();
-
-    let mut report = FileReport {
-        level,
-        ..FileReport::default()
-    };
-    report.times.decode = decode_s;
+    let (sharpness, mut report, inputs) = prepare_document(doc, asset, options)?;
     // The meshes are independent: smooth as many in parallel as there are threads, then store
     // them in file order. Only one such window of outputs (and of decoded inputs) is held at
     // a time, so a file of many large meshes never holds all their outputs at once.
@@ -227,24 +238,98 @@ fn smooth_meshes(
         }
         let outputs: Vec<Result<MeshOutput, Error>> = batch
             .par_iter()
-            .map(|m| mesh_job::smooth_mesh(m, &sharpness, level, options, asset))
+            .map(|m| smooth_one(m, &sharpness, options, asset))
             .collect();
         drop(batch);
         for out in outputs {
-            let out = out?;
             // Storing the new arrays in the document's buffer is the first half of writing.
             let store_start = Instant::now();
-            for (prim, data) in out.primitives {
-                gltf_io::replace_primitive_owned(doc, out.report.mesh, prim, data)
-                    .map_err(|e| Error::gltf(asset, e))?;
-            }
+            let mesh_report = lod::store_with_msft_lod(doc, out?, asset)?;
             left -= 1;
             stored(doc, left == 0)?;
             report.times.write += store_start.elapsed().as_secs_f64();
-            report.add_mesh(out.report);
+            report.add_mesh(mesh_report);
         }
     }
     Ok(report)
+}
+
+/// [`process_document`] for `--lod-files`: one document per level of the options' LOD chain,
+/// finest first, each with every mesh at that level; the meshes are smoothed once.
+pub fn process_document_per_level(
+    doc: &Document,
+    asset: &Path,
+    options: &Options,
+) -> Result<(FileReport, Vec<Document>), Error> {
+    let (mut report, outputs) = smooth_document(doc, asset, options)?;
+    let store_start = Instant::now();
+    let mut outputs: Vec<MeshOutput> = outputs.into_iter().collect::<Result<_, _>>()?;
+    let mut docs = Vec::new();
+    for level in 0..options.lod_levels().len().max(1) {
+        let mut copy = doc.clone();
+        for out in &mut outputs {
+            lod::store_level(&mut copy, out, level, asset)?;
+        }
+        docs.push(copy);
+    }
+    for out in outputs {
+        report.add_mesh(out.report);
+    }
+    report.times.write = store_start.elapsed().as_secs_f64();
+    Ok((report, docs))
+}
+
+/// Smooths every mesh of `doc` (the document is only read), in parallel, results in file
+/// order; each mesh under its own options (the sidecar's density keys over `options`).
+fn smooth_document(
+    doc: &Document,
+    asset: &Path,
+    options: &Options,
+) -> Result<(FileReport, Vec<Result<MeshOutput, Error>>), Error> {
+    let (sharpness, report, inputs) = prepare_document(doc, asset, options)?;
+    // The meshes are independent: smooth them in parallel, collect in file order.
+    let outputs = inputs
+        .par_iter()
+        .map(|m| smooth_one(m, &sharpness, options, asset))
+        .collect();
+    Ok((report, outputs))
+}
+
+/// What every mesh of `doc` shares before it is smoothed: the asset's sharpness settings (its
+/// sidecar), the size check, and every triangle primitive decoded; the report started.
+fn prepare_document(
+    doc: &Document,
+    asset: &Path,
+    options: &Options,
+) -> Result<(AssetSharpness, FileReport, Vec<MeshInput>), Error> {
+    let sharpness = asset_sharpness(doc, asset, options)?;
+    let level = sharpness.level().unwrap_or(options.level);
+
+    // Refuse what would not fit before decoding or allocating any of it. Per-edge counts are
+    // known only once a mesh's surface is built: that mesh is checked then, here its floor.
+    let varies = options.adaptive() || !options.lod_levels().is_empty() || sharpness.sets_density();
+    let floor = if varies { 1 } else { level };
+    check_output_size(doc, floor, options, asset)?;
+
+    let decode_start = Instant::now();
+    let inputs = mesh_inputs(doc, asset)?;
+    let mut report = FileReport {
+        level,
+        ..FileReport::default()
+    };
+    report.times.decode = decode_start.elapsed().as_secs_f64();
+    Ok((sharpness, report, inputs))
+}
+
+/// One mesh smoothed under its own options (the sidecar's density keys over `options`).
+fn smooth_one(
+    m: &MeshInput,
+    sharpness: &AssetSharpness,
+    options: &Options,
+    asset: &Path,
+) -> Result<MeshOutput, Error> {
+    let mesh_options = sharpness.mesh_options(m.mesh, options);
+    mesh_job::smooth_mesh(m, sharpness, mesh_options.level, &mesh_options, asset)
 }
 
 /// Every mesh with triangle primitives, decoded, in file order.

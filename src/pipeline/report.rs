@@ -214,6 +214,9 @@ pub struct MeshReport {
     /// or budget.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub adaptive: Option<AdaptiveFigures>,
+    /// With a LOD chain, each level, finest first: what it reached and where it was written.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub lod: Vec<LodReport>,
     /// What was repaired or ignored, typed; written as the `warnings` sentences and the
     /// `warning_details` objects.
     #[serde(flatten)]
@@ -221,6 +224,26 @@ pub struct MeshReport {
     /// Its stage times.
     #[serde(skip)]
     pub times: StageTimes,
+}
+
+/// One level of a mesh's LOD chain.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct LodReport {
+    /// 0 for the finest.
+    pub level: usize,
+    /// The budget this level was made for, when the chain is of budgets.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub triangle_budget: Option<u64>,
+    /// Triangles of the level, all primitives.
+    pub triangles: usize,
+    /// Vertices of the level, all primitives.
+    pub vertices: usize,
+    /// Target tolerance, measured chord error (the tolerance reached) and worst shape.
+    #[serde(flatten)]
+    pub figures: AdaptiveFigures,
+    /// The glTF mesh holding the level in the output (level 0: the mesh itself); `None` where
+    /// the level was not linked (a `--lod-files` run, or no node could carry it).
+    pub mesh: Option<usize>,
 }
 
 /// One file.
@@ -254,6 +277,11 @@ impl FileReport {
             self.triangles_in += p.triangles_in;
             self.triangles_out += p.triangles_out;
             self.vertices_out += p.vertices_out;
+        }
+        // Coarser levels are written too: they count as output.
+        for level in mesh.lod.iter().skip(1) {
+            self.triangles_out += level.triangles;
+            self.vertices_out += level.vertices;
         }
         self.times.add(&mesh.times);
         self.meshes.push(mesh);

@@ -140,6 +140,15 @@ pub enum Warning {
         count: usize,
         edge: usize,
     },
+    /// A node showing a mesh with a LOD chain cannot carry `MSFT_lod` (`reason` says why): it
+    /// shows the finest level only.
+    LodNodeNotLinked {
+        mesh: usize,
+        node: usize,
+        reason: String,
+    },
+    /// No node can show the coarser levels of a mesh's LOD chain: only the finest is written.
+    LodNotShown { mesh: usize },
 }
 
 impl Warning {
@@ -161,7 +170,9 @@ impl Warning {
             | Warning::NormalsGenerated { mesh, .. }
             | Warning::UnblendedEdgeEntry { mesh, .. }
             | Warning::BlendIgnored { mesh, .. }
-            | Warning::NoProjectionPlane { mesh, .. } => *mesh,
+            | Warning::NoProjectionPlane { mesh, .. }
+            | Warning::LodNodeNotLinked { mesh, .. }
+            | Warning::LodNotShown { mesh } => *mesh,
         }
     }
 
@@ -378,6 +389,14 @@ impl fmt::Display for Warning {
                 vertices,
                 "bow-tie vertices (triangle fans that touch only at the vertex)",
                 "are kept; each fan is smoothed on its own",
+            ),
+            Warning::LodNodeNotLinked { mesh, node, reason } => write!(
+                f,
+                "nodes[{node}]: mesh {mesh}'s coarser levels are not linked to this node: {reason}"
+            ),
+            Warning::LodNotShown { mesh } => write!(
+                f,
+                "meshes[{mesh}]: no node can show its coarser levels; only the finest level is written"
             ),
             Warning::ManyPieces { mesh, pieces } => write!(
                 f,

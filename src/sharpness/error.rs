@@ -60,6 +60,10 @@ pub enum Problem {
     CreaseAngleOutOfRange { got: f64 },
     #[error("level must be in [{}, {}], got {got}", crate::options::LEVEL.min, crate::options::LEVEL.max)]
     LevelOutOfRange { got: i64 },
+    /// A density key out of the range its flag has, in the options' words
+    /// (`is -1 (expected 0 or more world units)`).
+    #[error("{what}")]
+    Setting { what: String },
     #[error("expected {expected}, got {got}")]
     WrongType { expected: &'static str, got: String },
     #[error("unknown key `{key}`, expected one of {expected}")]

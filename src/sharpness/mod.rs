@@ -54,7 +54,7 @@ pub use error::{Location, Problem, SharpnessError};
 pub use explain::{explain_rows, ExplainRow, HSource};
 pub use extras::EXTRAS_KEY;
 pub use rules::{dihedral_degrees, is_crease, CREASE_SLACK_DEGREES};
-pub use sidecar::{sidecar_path_for, Sidecar, SIDECAR_SUFFIX};
+pub use sidecar::{sidecar_path_for, DensityKeys, Sidecar, SIDECAR_SUFFIX};
 
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeKind, Topology};
@@ -206,6 +206,34 @@ impl AssetSharpness {
     /// The per-asset tessellation level from the sidecar, if it sets one.
     pub fn level(&self) -> Option<u32> {
         self.sidecar.as_ref().and_then(Sidecar::level)
+    }
+
+    /// The options mesh `mesh` is tessellated with: `options` (flags, folder config,
+    /// `--config`) under the sidecar's top-level density keys, under the mesh section's.
+    pub fn mesh_options(
+        &self,
+        mesh: usize,
+        options: &crate::options::Options,
+    ) -> crate::options::Options {
+        let Some(sc) = &self.sidecar else {
+            return options.clone();
+        };
+        let asset = sc.density.apply(options.clone());
+        match self.section_of_mesh.get(&mesh) {
+            Some(&s) => sc.meshes[s].density.apply(asset),
+            None => asset,
+        }
+    }
+
+    /// Whether the sidecar sets a density key anywhere (then meshes may differ in density).
+    pub fn sets_density(&self) -> bool {
+        self.sidecar.as_ref().is_some_and(|sc| {
+            sc.density != DensityKeys::default()
+                || sc
+                    .meshes
+                    .iter()
+                    .any(|m| m.density != DensityKeys::default())
+        })
     }
 
     /// The sidecar in use, if any.

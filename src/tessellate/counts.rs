@@ -187,8 +187,12 @@ impl ChordErrors {
         if largest <= 0.0 {
             return (0.0, self.counts(topo, 1.0, cap));
         }
-        // At `hi` every count is 1; at `lo` every count is `cap`.
-        let (mut lo, mut hi) = (largest / (4.0 * f64::from(cap * cap)), largest * 1.01);
+        // At `hi` every count is 1 (the margin of `counts` included); at `lo` every count is
+        // `cap`.
+        let (mut lo, mut hi) = (
+            largest / (4.0 * f64::from(cap * cap)),
+            largest * MARGIN * 1.01,
+        );
         let mut best = (hi, self.counts(topo, hi, cap));
         if best.1.triangle_count(topo) > budget {
             return best;

@@ -10,6 +10,7 @@ mod buildsys_ninja;
 mod cli_batch;
 mod cli_exit_codes;
 mod cli_invalid;
+mod cli_lod;
 mod cli_nets;
 mod cli_watch;
 mod corpus;

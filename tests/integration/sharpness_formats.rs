@@ -51,7 +51,7 @@ fn sidecar_syntax_error_names_its_line() {
 fn sidecar_unknown_top_level_key_is_named() {
     assert_eq!(
         sidecar_error("h = 0.1\ncrease_angel = 60\n"),
-        "robot.g2tess.toml:2: unknown field `crease_angel`, expected one of `h`, `crease_angle`, `level`, `mesh`"
+        "robot.g2tess.toml:2: unknown field `crease_angel`, expected one of `h`, `crease_angle`, `level`, `tolerance`, `relative_tolerance`, `triangle_budget`, `max_segments`, `mesh`"
     );
 }
 

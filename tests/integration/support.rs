@@ -324,3 +324,12 @@ pub fn boundary_edges(positions: &[[f32; 3]], indices: &[u32]) -> usize {
     }
     uses.values().filter(|&&u| u == 1).count()
 }
+
+/// Runs `f` in a rayon pool of `threads` threads (for byte-identical-output checks).
+pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
