@@ -128,15 +128,27 @@ proptest! {
         reorder(&mut mesh, &rot, &flip);
         check(&mesh, h, profile)?;
 
-        // G1 at the vertex: near the centre every triangle's normal approaches the vertex normal.
+        // G1 at the vertex: near the centre every triangle's normal approaches the vertex
+        // normal, linearly in the distance (the patches share the tangent plane there, so the
+        // angle is the surface's curvature times the distance: a tenth of it at a tenth of the
+        // distance). A fixed bound would not do: strongly tilted normals curve a patch by 10⁴°
+        // per unit near its corner, and that is still G1. 1e-6° is the rounding floor of the
+        // normal at unit scale.
         let topo = Topology::build(&mesh);
         let s = G2Surface::new(&mesh, &topo, &vec![h; topo.edge_count()], profile);
+        let angle_at = |t: usize, c: usize, d: f64| {
+            let mut l = [d / 2.0; 3];
+            l[c] = 1.0 - d;
+            angle_deg(s.evaluate(t, l).normal, mesh.normals[0])
+        };
         for (t, tri) in mesh.triangles.iter().enumerate() {
             let c = tri.iter().position(|&v| v == 0).expect("fan triangles use the centre");
-            let mut l = [0.5e-7; 3];
-            l[c] = 1.0 - 1e-7;
-            let angle = angle_deg(s.evaluate(t, l).normal, mesh.normals[0]);
-            prop_assert!(angle < 1e-3, "triangle {} normal {}° from the vertex normal", t, angle);
+            let (near, nearer) = (angle_at(t, c, 1e-6), angle_at(t, c, 1e-7));
+            prop_assert!(
+                nearer <= 0.11 * near + 1e-6,
+                "triangle {} normal {}° from the vertex normal at 1e-7, {}° at 1e-6",
+                t, nearer, near
+            );
         }
     }
 }
