@@ -97,6 +97,9 @@ fn stream_file(
     let mut report = smooth_meshes(&mut doc, input, options, &mut |doc, last| {
         out.flush(doc, last).map_err(at_output)
     })?;
+    // A stop that came while the last mesh was written: the temporaries go, nothing is
+    // renamed into place.
+    mesh_job::stop_if_cancelled(options, input)?;
     let finish_start = Instant::now();
     let done = out.finish(&doc).map_err(at_output)?;
     report.times.read = read_s;

@@ -224,7 +224,8 @@ fn a_sidecar_level_past_64_is_refused() {
 #[test]
 fn sigterm_stops_the_file_in_flight() {
     let dir = corpus::temp_dir();
-    // A fan of 100 000 triangles at level 8: about two seconds of work.
+    // A fan of 100 000 triangles at level 12 (14.4 M output triangles): two to three seconds
+    // of work, so the signal at 0.7 s lands while the file is in flight.
     let n = 100_000u32;
     let turn = |i: u32| std::f32::consts::TAU * i as f32 / n as f32;
     let mut p = vec![[0.0f32, 0.0, 0.0]];
@@ -239,7 +240,7 @@ fn sigterm_stops_the_file_in_flight() {
             "-o".as_ref(),
             output.as_os_str(),
             "--level".as_ref(),
-            "8".as_ref(),
+            "12".as_ref(),
         ])
         .stderr(std::process::Stdio::piped())
         .spawn()
