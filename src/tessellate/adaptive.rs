@@ -19,11 +19,10 @@ use rayon::prelude::*;
 
 use super::blocks::{self, Block};
 use super::counts::SegmentCounts;
+use super::emit;
 use super::layout::GroupLayout;
 use super::transition::{Pattern, PatternKey};
-use super::{
-    canonical_forward, corner_vertex, evaluator, DenseMesh, VertexSource, BLOCK_TRIANGLES,
-};
+use super::{canonical_forward, evaluator, DenseMesh, VertexSource, BLOCK_TRIANGLES};
 use crate::mesh::TriMesh;
 use crate::surface::{LatticePart, Surface, SurfacePoint};
 use crate::topology::Topology;
@@ -206,16 +205,21 @@ fn tessellate_block(
         shared.surface,
         shared.edge_samples,
     );
-    let mut interior: Vec<SurfacePoint> = Vec::new();
-    let mut own_edge: Vec<SurfacePoint> = Vec::new();
+    let mut writer = emit::TriangleWriter::new(
+        mesh,
+        topo,
+        surface,
+        &edge_samples.positions,
+        &edge_samples.normals,
+    );
     let mut local: Vec<u32> = Vec::new();
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
         let pattern = shared.pattern(tri);
         let corners = mesh.triangles[tri];
         let owns = layout.owns[offset];
-        let source = |p: u32| {
-            let [level, i, j] = pattern.lattice[p as usize];
+        let source = |p: usize| {
+            let [level, i, j] = pattern.lattice[p];
             VertexSource {
                 tri: tri as u32,
                 level,
@@ -225,77 +229,46 @@ fn tessellate_block(
         };
         local.clear();
         local.resize(pattern.lattice.len(), 0);
-
-        for (c, point) in local.iter_mut().take(3).enumerate() {
+        for c in 0..3 {
             let slot = layout.corner_slot[3 * offset + c] as usize;
-            *point = slot as u32;
-            if owns & (1 << c) != 0 {
-                let (position, normal) = corner_vertex(mesh, surface, tri, c);
-                block.put(slot, position, normal, source(c as u32));
-            }
+            let owned = owns & (1 << c) != 0;
+            writer.corner(&mut block, &mut local, tri, c, c, slot, owned, source(c));
         }
-
         for k in 0..3 {
-            let n = pattern.key.edges[k];
-            let (a, b) = (corners[(k + 1) % 3], corners[(k + 2) % 3]);
-            let first = layout.edge_slot[3 * offset + k] as usize;
-            let slot = |m: u32| first + (if a <= b { m } else { n - m } - 1) as usize;
-            let point = |m: u32| pattern.edge_start[k] + m - 1;
-            if owns & (8 << k) == 0 {
-                for m in 1..n {
-                    local[point(m) as usize] = slot(m) as u32;
-                }
-                continue;
-            }
-            let e = topo.tri_edges[tri][k].0 as usize;
-            let forward = canonical_forward(topo, tri, k);
-            let evaluated_here = evaluator(topo, e) == Some((tri, k));
-            if !evaluated_here {
-                own_edge.clear();
-                surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut own_edge);
-            }
-            for m in 1..n {
-                let s = slot(m);
-                local[point(m) as usize] = s as u32;
-                let welded = edge_samples.start[e] + (if forward { m } else { n - m } - 1) as usize;
-                let normal = if evaluated_here {
-                    edge_samples.normals[welded]
-                } else {
-                    own_edge[(m - 1) as usize].normal.as_vec3().to_array()
-                };
-                block.put(s, edge_samples.positions[welded], normal, source(point(m)));
-            }
+            writer.edge(
+                &mut block,
+                &mut local,
+                tri,
+                k,
+                pattern.key.edges[k],
+                layout.edge_slot[3 * offset + k] as usize,
+                corners[(k + 1) % 3] <= corners[(k + 2) % 3],
+                owns & (8 << k) != 0,
+                |e| edge_samples.start[e],
+                |m| (pattern.edge_start[k] + m - 1) as usize,
+                source,
+            );
         }
-
         if !pattern.interior_by_rank.is_empty() {
-            interior.clear();
-            surface.evaluate_lattice_part(
+            let start = pattern.interior_start as usize;
+            writer.interior(
+                &mut block,
+                &mut local,
                 tri,
                 pattern.key.inner,
-                LatticePart::Interior,
-                &mut interior,
+                layout.base[offset + 1] as usize - pattern.interior_by_rank.len(),
+                pattern
+                    .interior_by_rank
+                    .iter()
+                    .map(|&index| (start + index as usize, index as usize)),
+                source,
             );
-            let interior_base = layout.base[offset + 1] as usize - pattern.interior_by_rank.len();
-            for (rank, &index) in pattern.interior_by_rank.iter().enumerate() {
-                let point = pattern.interior_start + index;
-                let slot = interior_base + rank;
-                local[point as usize] = slot as u32;
-                let p = &interior[index as usize];
-                block.put(
-                    slot,
-                    p.position.as_vec3().to_array(),
-                    p.normal.as_vec3().to_array(),
-                    source(point),
-                );
-            }
         }
-
         let start = index_base[offset] - block.index_base;
-        let out = &mut block.indices[start..start + 3 * pattern.triangles.len()];
-        for (dst, t) in out.chunks_exact_mut(3).zip(&pattern.triangles) {
-            dst[0] = local[t[0] as usize];
-            dst[1] = local[t[1] as usize];
-            dst[2] = local[t[2] as usize];
-        }
+        emit::triangles(
+            &mut block.indices[start..start + 3 * pattern.triangles.len()],
+            &pattern.triangles,
+            &local,
+        );
     }
 }

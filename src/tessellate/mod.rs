@@ -30,7 +30,8 @@
 //! Each output vertex is evaluated once: a corner is the input vertex (no evaluation), the
 //! samples of a welded edge come from one shared pass, positions and normals (a triangle that
 //! owns a split copy of them evaluates only its own normals there), and each triangle evaluates
-//! only its interior ([`LatticePart`]).
+//! only its interior ([`LatticePart`]). That per-triangle loop is one piece of code
+//! (`emit.rs`) for this uniform path and the per-edge-count path (`adaptive.rs`).
 //! Blocks run in parallel (rayon) and write straight into those ranges: no per-vertex
 //! allocation, no hash map, and the same bytes at any thread count. Triangles come out in
 //! cache-friendly bands and vertices in order of first use, so meshoptimizer's passes have
@@ -40,6 +41,7 @@ mod adaptive;
 mod blocks;
 mod chord;
 mod counts;
+mod emit;
 mod estimate;
 mod lattice_edges;
 mod layout;
@@ -351,8 +353,13 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
     let n = plan.n;
     let per_edge = (n - 1) as usize;
     let per_tri_indices = 3 * (n * n) as usize;
-    let mut interior: Vec<SurfacePoint> = Vec::with_capacity(plan.interior);
-    let mut own_edge: Vec<SurfacePoint> = Vec::with_capacity(per_edge);
+    let mut writer = emit::TriangleWriter::new(
+        mesh,
+        topo,
+        surface,
+        &edge_samples.positions,
+        &edge_samples.normals,
+    );
     let mut local = vec![0u32; plan.len];
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
@@ -368,74 +375,53 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
                 j,
             }
         };
-
         for (c, &li) in plan.corners.iter().enumerate() {
-            let li = li as usize;
             let slot = layout.corner_slot[3 * offset + c] as usize;
-            local[li] = slot as u32;
-            if owns & (1 << c) != 0 {
-                let (position, normal) = corner_vertex(mesh, surface, tri, c);
-                block.put(slot, position, normal, source(li));
-            }
+            let owned = owns & (1 << c) != 0;
+            writer.corner(
+                &mut block,
+                &mut local,
+                tri,
+                c,
+                li as usize,
+                slot,
+                owned,
+                source(li as usize),
+            );
         }
-
         for (k, lis) in plan.edges.iter().enumerate() {
-            let (a, b) = (corners[(k + 1) % 3], corners[(k + 2) % 3]);
-            let first = layout.edge_slot[3 * offset + k] as usize;
-            // Slot along the input edge, walked from its lower input index.
-            let slot = |m: u32| first + (if a <= b { m } else { n - m } - 1) as usize;
-            if owns & (8 << k) == 0 {
-                for (m, &li) in (1..n).zip(lis) {
-                    local[li as usize] = slot(m) as u32;
-                }
-                continue;
-            }
-            let e = topo.tri_edges[tri][k].0 as usize;
-            let forward = canonical_forward(topo, tri, k);
-            // Positions always come from the shared pass (bit-watertight); normals too when this
-            // side evaluated it, else from this side's own surface (they differ across creases).
-            let evaluated_here = evaluator(topo, e) == Some((tri, k));
-            if !evaluated_here {
-                own_edge.clear();
-                surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut own_edge);
-            }
-            for (m, &li) in (1..n).zip(lis) {
-                let li = li as usize;
-                let s = slot(m);
-                local[li] = s as u32;
-                let welded = e * per_edge + (if forward { m } else { n - m } - 1) as usize;
-                let normal = if evaluated_here {
-                    edge_samples.normals[welded]
-                } else {
-                    own_edge[(m - 1) as usize].normal.as_vec3().to_array()
-                };
-                block.put(s, edge_samples.positions[welded], normal, source(li));
-            }
+            writer.edge(
+                &mut block,
+                &mut local,
+                tri,
+                k,
+                n,
+                layout.edge_slot[3 * offset + k] as usize,
+                corners[(k + 1) % 3] <= corners[(k + 2) % 3],
+                owns & (8 << k) != 0,
+                |e| e * per_edge,
+                |m| lis[(m - 1) as usize] as usize,
+                source,
+            );
         }
-
         if plan.interior > 0 {
-            interior.clear();
-            surface.evaluate_lattice_part(tri, n, LatticePart::Interior, &mut interior);
-            let interior_base = layout.base[offset + 1] as usize - plan.interior;
-            for (rank, &(li, index)) in plan.interior_by_rank.iter().enumerate() {
-                let (li, slot) = (li as usize, interior_base + rank);
-                local[li] = slot as u32;
-                let p = &interior[index as usize];
-                block.put(
-                    slot,
-                    p.position.as_vec3().to_array(),
-                    p.normal.as_vec3().to_array(),
-                    source(li),
-                );
-            }
+            writer.interior(
+                &mut block,
+                &mut local,
+                tri,
+                n,
+                layout.base[offset + 1] as usize - plan.interior,
+                plan.interior_by_rank
+                    .iter()
+                    .map(|&(li, index)| (li as usize, index as usize)),
+                source,
+            );
         }
-
         let start = (offset - block.tris.start) * per_tri_indices;
-        let out = &mut block.indices[start..start + per_tri_indices];
-        for (dst, t) in out.chunks_exact_mut(3).zip(&plan.triangles) {
-            dst[0] = local[t[0] as usize];
-            dst[1] = local[t[1] as usize];
-            dst[2] = local[t[2] as usize];
-        }
+        emit::triangles(
+            &mut block.indices[start..start + per_tri_indices],
+            &plan.triangles,
+            &local,
+        );
     }
 }

@@ -1,0 +1,164 @@
+//! Writing one source triangle into its block: the per-triangle loop the uniform and the
+//! per-edge-count tessellators share. They differ only in how a triangle's lattice is laid out
+//! (one [`super::plan::LatticePlan`] per level, or one transition pattern per set of counts);
+//! each step here takes the layout's answer (which local point, which output slot) and does
+//! the rest the same way on both paths:
+//! - corners are the input vertices, written by the triangle that owns them;
+//! - edge samples take their position from the shared pass (so a welded edge is bit-watertight)
+//!   and their normal from it too when this triangle evaluated the edge, else from this side's
+//!   own surface (normals differ across a crease);
+//! - interior points are evaluated here, as one lattice part;
+//! - triangles are written by local point, through the local-to-slot map the steps fill.
+
+use super::blocks::Block;
+use super::{canonical_forward, corner_vertex, evaluator, VertexSource};
+use crate::mesh::TriMesh;
+use crate::surface::{LatticePart, Surface, SurfacePoint};
+use crate::topology::Topology;
+
+/// What the steps of one triangle read, and the scratch they reuse from triangle to triangle.
+pub(super) struct TriangleWriter<'a> {
+    pub mesh: &'a TriMesh,
+    pub topo: &'a Topology,
+    pub surface: &'a dyn Surface,
+    /// Shared edge samples, every welded edge's run in its canonical direction.
+    pub sample_positions: &'a [[f32; 3]],
+    pub sample_normals: &'a [[f32; 3]],
+    own_edge: Vec<SurfacePoint>,
+    interior: Vec<SurfacePoint>,
+}
+
+impl<'a> TriangleWriter<'a> {
+    pub fn new(
+        mesh: &'a TriMesh,
+        topo: &'a Topology,
+        surface: &'a dyn Surface,
+        sample_positions: &'a [[f32; 3]],
+        sample_normals: &'a [[f32; 3]],
+    ) -> Self {
+        TriangleWriter {
+            mesh,
+            topo,
+            surface,
+            sample_positions,
+            sample_normals,
+            own_edge: Vec::new(),
+            interior: Vec::new(),
+        }
+    }
+
+    /// Corner `c` of `tri`, local point `point`, output slot `slot`; written if `owned`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn corner(
+        &self,
+        block: &mut Block<'_>,
+        local: &mut [u32],
+        tri: usize,
+        c: usize,
+        point: usize,
+        slot: usize,
+        owned: bool,
+        source: VertexSource,
+    ) {
+        local[point] = slot as u32;
+        if owned {
+            let (position, normal) = corner_vertex(self.mesh, self.surface, tri, c);
+            block.put(slot, position, normal, source);
+        }
+    }
+
+    /// The `n − 1` samples of edge `k` of `tri`: sample `m` (1 to n − 1, from corner
+    /// `(k + 1) % 3`) is local point `point(m)`; the edge's output slots start at `first_slot`
+    /// and run from its lower input vertex (`ascending`: that is corner `(k + 1) % 3`); the
+    /// shared samples of its welded edge `e` start at `samples_of(e)`. Written if `owned`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn edge(
+        &mut self,
+        block: &mut Block<'_>,
+        local: &mut [u32],
+        tri: usize,
+        k: usize,
+        n: u32,
+        first_slot: usize,
+        ascending: bool,
+        owned: bool,
+        samples_of: impl Fn(usize) -> usize,
+        point: impl Fn(u32) -> usize,
+        source: impl Fn(usize) -> VertexSource,
+    ) {
+        let slot = |m: u32| first_slot + (if ascending { m } else { n - m } - 1) as usize;
+        if !owned {
+            for m in 1..n {
+                local[point(m)] = slot(m) as u32;
+            }
+            return;
+        }
+        let e = self.topo.tri_edges[tri][k].0 as usize;
+        let forward = canonical_forward(self.topo, tri, k);
+        let evaluated_here = evaluator(self.topo, e) == Some((tri, k));
+        if !evaluated_here {
+            self.own_edge.clear();
+            self.surface.evaluate_lattice_part(
+                tri,
+                n,
+                LatticePart::Edge(k as u8),
+                &mut self.own_edge,
+            );
+        }
+        let first_sample = samples_of(e);
+        for m in 1..n {
+            let (p, s) = (point(m), slot(m));
+            local[p] = s as u32;
+            let welded = first_sample + (if forward { m } else { n - m } - 1) as usize;
+            let normal = if evaluated_here {
+                self.sample_normals[welded]
+            } else {
+                self.own_edge[(m - 1) as usize].normal.as_vec3().to_array()
+            };
+            block.put(s, self.sample_positions[welded], normal, source(p));
+        }
+    }
+
+    /// The interior of `tri` on its lattice of `level`: `by_rank` gives, in output order, each
+    /// interior point's local point and its index in the lattice part; their slots are
+    /// consecutive from `first_slot`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn interior(
+        &mut self,
+        block: &mut Block<'_>,
+        local: &mut [u32],
+        tri: usize,
+        level: u32,
+        first_slot: usize,
+        by_rank: impl Iterator<Item = (usize, usize)>,
+        source: impl Fn(usize) -> VertexSource,
+    ) {
+        self.interior.clear();
+        self.surface
+            .evaluate_lattice_part(tri, level, LatticePart::Interior, &mut self.interior);
+        for (rank, (point, index)) in by_rank.enumerate() {
+            let slot = first_slot + rank;
+            local[point] = slot as u32;
+            let p = &self.interior[index];
+            block.put(
+                slot,
+                p.position.as_vec3().to_array(),
+                p.normal.as_vec3().to_array(),
+                source(point),
+            );
+        }
+    }
+}
+
+/// `triangles` by local point, written as output slots through `local`.
+#[inline]
+pub(super) fn triangles(out: &mut [u32], triangles: &[[u32; 3]], local: &[u32]) {
+    for (dst, t) in out.chunks_exact_mut(3).zip(triangles) {
+        dst[0] = local[t[0] as usize];
+        dst[1] = local[t[1] as usize];
+        dst[2] = local[t[2] as usize];
+    }
+}
