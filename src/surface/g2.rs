@@ -351,57 +351,60 @@ fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
     Local { net, normal }
 }
 
-impl Surface for G2Surface {
-    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
-        let patch = &self.patches[tri];
-        let w = PointWeights::at(bary, self.widths(patch), self.profile);
-        let local = self.local(tri);
+/// One patch set up for single points: its net broadcast once, and each neighbour's net
+/// composed (Eq. 3) the first time a point blends across that edge, then kept. A single point
+/// and a batch of them run the same arithmetic, so they agree bit for bit.
+struct PointEvaluation<'a> {
+    patch: &'a Patch,
+    widths: [f64; 3],
+    local: Local,
+    own: Broadcast<1>,
+    across: [Option<Broadcast<1>>; 3],
+}
+
+impl<'a> PointEvaluation<'a> {
+    fn new(surface: &'a G2Surface, tri: usize) -> Self {
+        let patch = &surface.patches[tri];
+        let local = surface.local(tri);
+        PointEvaluation {
+            patch,
+            widths: surface.widths(patch),
+            own: broadcast(&local.net),
+            local,
+            across: [None; 3],
+        }
+    }
+
+    fn at(&mut self, surface: &G2Surface, bary: [f64; 3]) -> SurfacePoint {
+        let w = PointWeights::at(bary, self.widths, surface.profile);
         if let Some(c) = w.corner {
             let c = c as usize;
             return SurfacePoint {
-                position: corner(&local.net, c),
-                normal: local.normal[c],
+                position: corner(&self.local.net, c),
+                normal: self.local.normal[c],
             };
         }
-        let own = broadcast(&local.net);
-        let across = w
-            .blended
-            .then(|| broadcast(&self.across_net(patch, w.k as usize)));
-        let [p] = Self::combine(
-            &local.normal,
-            &Lanes::<1>::single(&w),
-            &own,
-            across.as_ref(),
-        );
+        let patch = self.patch;
+        let net = w.blended.then(|| {
+            let k = w.k as usize;
+            &*self.across[k].get_or_insert_with(|| broadcast(&surface.across_net(patch, k)))
+        });
+        let [p] = G2Surface::combine(&self.local.normal, &Lanes::<1>::single(&w), &self.own, net);
         p
+    }
+}
+
+impl Surface for G2Surface {
+    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
+        let mut out = PointEvaluation::new(self, tri);
+        out.at(self, bary)
     }
 
     /// [`Surface::evaluate`] point by point, with the own net broadcast and each neighbour's
     /// net composed once for all of them instead of once per point.
     fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
-        let patch = &self.patches[tri];
-        let widths = self.widths(patch);
-        let local = self.local(tri);
-        let own = broadcast(&local.net);
-        let mut across: [Option<Broadcast<1>>; 3] = [None; 3];
-        out.reserve(barys.len());
-        for &bary in barys {
-            let w = PointWeights::at(bary, widths, self.profile);
-            if let Some(c) = w.corner {
-                let c = c as usize;
-                out.push(SurfacePoint {
-                    position: corner(&local.net, c),
-                    normal: local.normal[c],
-                });
-                continue;
-            }
-            let net = w.blended.then(|| {
-                let k = w.k as usize;
-                &*across[k].get_or_insert_with(|| broadcast(&self.across_net(patch, k)))
-            });
-            let [p] = Self::combine(&local.normal, &Lanes::<1>::single(&w), &own, net);
-            out.push(p);
-        }
+        let mut points = PointEvaluation::new(self, tri);
+        out.extend(barys.iter().map(|&bary| points.at(self, bary)));
     }
 
     fn evaluate_lattice_part(
