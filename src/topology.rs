@@ -534,7 +534,7 @@ fn has_split_normals(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -662,8 +662,9 @@ mod tests {
     }
 
     /// Odd shapes on few positions: books (many triangles on one edge), fans, duplicates in
-    /// every corner order, degenerate and open triangles, signed zeros.
-    fn odd_mesh(seed: u64, tris: usize) -> TriMesh {
+    /// every corner order, degenerate and open triangles, signed zeros. The geometry checks'
+    /// tests use them too.
+    pub(crate) fn odd_mesh(seed: u64, tris: usize) -> TriMesh {
         let mut state = seed;
         let mut next = move |n: u64| {
             state = state

@@ -321,35 +321,8 @@ fn root(p: &mut [u32], mut i: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::topology::tests::odd_mesh;
     use crate::topology::VertId;
-
-    /// Books, fans, bow-ties, copies in every corner order and collapsed triangles on a few
-    /// positions.
-    fn odd_mesh(seed: u64, tris: usize) -> TriMesh {
-        let mut state = seed;
-        let mut next = move |n: u64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) % n
-        };
-        let positions: Vec<DVec3> = (0..30)
-            .map(|_| DVec3::new(next(4) as f64, next(4) as f64, next(3) as f64))
-            .collect();
-        let mut triangles = Vec::new();
-        while triangles.len() < tris {
-            let t = [next(30), next(30), next(30)].map(|v| v as u32);
-            triangles.push(t);
-            if next(4) == 0 {
-                triangles.push([t[2], t[0], t[1]]);
-            }
-        }
-        TriMesh {
-            normals: vec![DVec3::Z; positions.len()],
-            positions,
-            triangles,
-        }
-    }
 
     /// Bow-tie vertices the slow way: per vertex, its distinct triangles joined when they
     /// share an edge through it, components counted by search.
