@@ -43,6 +43,8 @@ pub fn process_file(input: &Path, output: &Path, options: &Options) -> Result<Fi
     if !streams(options) {
         let started = Instant::now();
         let (mut report, files) = encode_file(input, output, options)?;
+        // As on the streamed path: a stop that came while encoding writes nothing.
+        mesh_job::stop_if_cancelled(options, input)?;
         let write_start = Instant::now();
         gltf_io::write_files_atomically(&files).map_err(|e| Error::gltf(output, e))?;
         report.times.write += write_start.elapsed().as_secs_f64();
@@ -98,7 +100,7 @@ fn stream_file(
         out.flush(doc, last).map_err(at_output)
     })?;
     // A stop that came while the last mesh was written: the temporaries go, nothing is
-    // renamed into place.
+    // renamed into place (the in-memory path in `process_file` checks at the same point).
     mesh_job::stop_if_cancelled(options, input)?;
     let finish_start = Instant::now();
     let done = out.finish(&doc).map_err(at_output)?;
