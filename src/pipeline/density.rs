@@ -77,6 +77,15 @@ impl Density {
         Density::Counts { counts, target }
     }
 
+    /// Whether `self` gives the same output as `other`: the same level, or the same counts.
+    pub fn same_output(&self, other: &Density) -> bool {
+        match (self, other) {
+            (Density::Level(a), Density::Level(b)) => a == b,
+            (Density::Counts { counts: a, .. }, Density::Counts { counts: b, .. }) => a == b,
+            _ => false,
+        }
+    }
+
     /// Output triangles, before tessellating.
     pub fn triangle_count(&self, mesh: &TriMesh, topo: &Topology) -> u64 {
         match self {

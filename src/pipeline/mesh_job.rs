@@ -189,7 +189,7 @@ pub fn smooth_mesh(
     report.warnings.0.extend(
         surface_warnings
             .iter()
-            .map(|w| Warning::from_surface(input.mesh, None, w)),
+            .filter_map(|w| Warning::from_surface(input.mesh, None, w)),
     );
     report.edges = if options.report_figures {
         EdgeFigures::measure(surface.as_ref(), &topo, &effective)
@@ -201,7 +201,9 @@ pub fn smooth_mesh(
 
     // One level, or every level of the LOD chain from the one surface: only the counts and
     // the tessellation are per level.
-    let chain = options.lod_levels();
+    // The sidecar's density keys apply to each level as to one: a block that decides its
+    // mesh's density fixes it at every level.
+    let chain = sharpness.mesh_lod_levels(input.mesh, options);
     let is_chain = !chain.is_empty();
     let levels = if chain.is_empty() {
         vec![options.clone()]
@@ -210,7 +212,10 @@ pub fn smooth_mesh(
     };
     let mut primitives = Vec::new();
     let mut lods = Vec::new();
-    let mut previous_counts = None;
+    let mut previous: Option<Density> = None;
+    // Every level written is held (and, with MSFT_lod, stored in the one file): the limit is
+    // on their sum.
+    let mut planned_total = 0u64;
     // The G² surface holds about 240 bytes per input triangle: freed once the last level is
     // tessellated, before its attributes are carried, when the dense mesh is at its largest.
     let mut surface = Some(surface);
@@ -219,13 +224,10 @@ pub fn smooth_mesh(
         let tess_start = Instant::now();
         let live = surface.as_deref().expect("freed after the last level only");
         let density = Density::choose(level_options, level, &mesh, &topo, live);
-        let counts = match &density {
-            Density::Counts { counts, .. } => Some(counts.clone()),
-            Density::Level(_) => None,
-        };
-        if k > 0 && counts.is_some() && counts == previous_counts {
+        if previous.as_ref().is_some_and(|p| p.same_output(&density)) {
             // A looser tolerance (or a larger budget) that changes no count: a flat mesh at one
-            // segment per edge, say. The level before is this level.
+            // segment per edge, say, or a sidecar that fixes the mesh's density. The level
+            // before is this level.
             let mut same = report.lod[k - 1].clone();
             same.level = k;
             if let Density::Counts { target, .. } = &density {
@@ -237,13 +239,19 @@ pub fn smooth_mesh(
             lods.push(None);
             continue;
         }
-        previous_counts = counts;
         let planned = density.triangle_count(&mesh, &topo);
-        if planned > options.max_output_triangles {
+        previous = Some(density.clone());
+        planned_total = planned_total.saturating_add(planned);
+        if planned_total > options.max_output_triangles {
+            let what = if is_chain {
+                format!("levels 0 to {k} of its LOD chain would get {planned_total} triangles")
+            } else {
+                format!("would get {planned} triangles")
+            };
             return Err(Error::limit(
                 asset,
                 format!(
-                    "mesh {} would get {planned} triangles, over --max-triangles {} (expected a larger tolerance, a --triangle-budget or a larger --max-triangles)",
+                    "mesh {} {what}, over --max-triangles {} (expected a larger tolerance, a --triangle-budget or a larger --max-triangles)",
                     input.mesh, options.max_output_triangles
                 ),
             ));
@@ -275,7 +283,7 @@ pub fn smooth_mesh(
             // Every level's targets are made by the same surfaces: their warnings once.
             let target_warnings = target_warnings
                 .iter()
-                .map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
+                .filter_map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
                 .collect();
             merge_target_warnings(&mut report.warnings.0, target_warnings);
         }

@@ -390,7 +390,7 @@ fn asset_sharpness(
 /// which source set its h, so a user can see why an edge is sharp.
 pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<String>, Error> {
     let doc = gltf_io::read(input, &options.read_options()).map_err(|e| Error::gltf(input, e))?;
-    let sharpness = asset_sharpness(&doc, input, options)?;
+    let sharpness = asset_sharpness(&doc, input, options)?.with_sources();
     let inputs = mesh_inputs(&doc, input)?;
     // As in a sidecar section: digits name an index, anything else a name, which must be
     // unique among the meshes with triangles.

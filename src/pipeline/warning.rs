@@ -121,19 +121,9 @@ pub enum Warning {
         #[serde(serialize_with = "serialize_location")]
         at: Location,
     },
-    /// The surface was asked to blend `count` edges of a kind it never blends; they use
-    /// h = 0. `targets` names the morph targets whose surfaces said so (empty: the base's).
-    BlendIgnored {
-        mesh: usize,
-        targets: Vec<usize>,
-        #[serde(serialize_with = "serialize_edge_kind")]
-        edge_kind: EdgeKind,
-        count: usize,
-        /// The first such welded edge.
-        edge: usize,
-    },
     /// The hybrid scheme found no projection plane for `count` folded interior edges (the first:
-    /// welded edge `edge`): they are creases. `targets` as in [`Warning::BlendIgnored`].
+    /// welded edge `edge`): they are creases. `targets` names the morph targets whose surfaces
+    /// said so (empty: the base's).
     NoProjectionPlane {
         mesh: usize,
         targets: Vec<usize>,
@@ -169,7 +159,6 @@ impl Warning {
             | Warning::NormalsRepaired { mesh, .. }
             | Warning::NormalsGenerated { mesh, .. }
             | Warning::UnblendedEdgeEntry { mesh, .. }
-            | Warning::BlendIgnored { mesh, .. }
             | Warning::NoProjectionPlane { mesh, .. }
             | Warning::LodNodeNotLinked { mesh, .. }
             | Warning::LodNotShown { mesh } => *mesh,
@@ -193,18 +182,20 @@ impl Warning {
 
     /// A surface's warning about mesh `mesh`, from the base surface (`target` `None`) or the
     /// surface of one morph target.
-    pub fn from_surface(mesh: usize, target: Option<usize>, w: &scheme::Warning) -> Warning {
+    ///
+    /// `None` for a surface's "blend ignored" ([`topology::Warning::BlendIgnored`]): the
+    /// pipeline builds every surface, the morph targets' too, from the effective widths
+    /// ([`crate::sharpness::EffectiveH`]), already 0 on every edge the surface cannot blend, so
+    /// a surface never says it here; the one input that asks for it, an h entry naming such an
+    /// edge, is reported where it is resolved ([`Warning::UnblendedEdgeEntry`]).
+    pub fn from_surface(
+        mesh: usize,
+        target: Option<usize>,
+        w: &scheme::Warning,
+    ) -> Option<Warning> {
         let targets: Vec<usize> = target.into_iter().collect();
-        match w {
-            scheme::Warning::Edges(topology::Warning::BlendIgnored { kind, edges, first }) => {
-                Warning::BlendIgnored {
-                    mesh,
-                    targets,
-                    edge_kind: *kind,
-                    count: *edges,
-                    edge: first.0 as usize,
-                }
-            }
+        Some(match w {
+            scheme::Warning::Edges(topology::Warning::BlendIgnored { .. }) => return None,
             scheme::Warning::Edges(topology::Warning::DegenerateTriangle { tri }) => {
                 Warning::DegenerateTriangles {
                     mesh,
@@ -225,15 +216,13 @@ impl Warning {
                 count: *edges,
                 edge: first.0 as usize,
             },
-        }
+        })
     }
 
     /// The morph targets whose surfaces gave it (empty for everything else).
     pub fn targets(&self) -> &[usize] {
         match self {
-            Warning::BlendIgnored { targets, .. } | Warning::NoProjectionPlane { targets, .. } => {
-                targets
-            }
+            Warning::NoProjectionPlane { targets, .. } => targets,
             _ => &[],
         }
     }
@@ -248,9 +237,7 @@ impl Warning {
     }
 
     fn set_targets(&mut self, to: Vec<usize>) {
-        if let Warning::BlendIgnored { targets, .. } | Warning::NoProjectionPlane { targets, .. } =
-            self
-        {
+        if let Warning::NoProjectionPlane { targets, .. } = self {
             *targets = to;
         }
     }
@@ -446,21 +433,6 @@ impl fmt::Display for Warning {
                 h: *h,
             }
             .fmt(f),
-            Warning::BlendIgnored {
-                mesh,
-                targets,
-                edge_kind,
-                count,
-                edge,
-            } => {
-                surface_prefix(f, *mesh, targets)?;
-                topology::Warning::BlendIgnored {
-                    kind: *edge_kind,
-                    edges: *count,
-                    first: EdgeId(*edge as u32),
-                }
-                .fmt(f)
-            }
             Warning::NoProjectionPlane {
                 mesh,
                 targets,
@@ -621,28 +593,23 @@ mod tests {
     /// `Display` gave, prefixed with the mesh as the report always did.
     #[test]
     fn surface_and_sharpness_sentences_are_unchanged() {
-        let said = [
-            scheme::Warning::NoProjectionPlane {
-                edges: 3,
-                first: EdgeId(9),
-            },
-            scheme::Warning::Edges(topology::Warning::BlendIgnored {
-                kind: EdgeKind::NonManifold,
-                edges: 2,
-                first: EdgeId(4),
-            }),
-            scheme::Warning::Edges(topology::Warning::BlendIgnored {
-                kind: EdgeKind::Boundary,
-                edges: 1,
-                first: EdgeId(0),
-            }),
-        ];
+        let said = [scheme::Warning::NoProjectionPlane {
+            edges: 3,
+            first: EdgeId(9),
+        }];
         for w in &said {
             assert_eq!(
-                Warning::from_surface(5, None, w).to_string(),
+                Warning::from_surface(5, None, w).unwrap().to_string(),
                 format!("mesh 5: {w}")
             );
         }
+        // Never said by a surface the pipeline builds (see `from_surface`).
+        let ignored = scheme::Warning::Edges(topology::Warning::BlendIgnored {
+            kind: EdgeKind::Boundary,
+            edges: 1,
+            first: EdgeId(0),
+        });
+        assert_eq!(Warning::from_surface(5, None, &ignored), None);
         let entry = SharpnessWarning::EntryOnUnblendedEdge {
             at: Location::Toml {
                 file: "robot.g2tess.toml".into(),

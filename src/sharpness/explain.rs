@@ -137,8 +137,14 @@ impl fmt::Display for ExplainRow {
     }
 }
 
-/// One row per edge, in edge order.
+/// One row per edge, in edge order, from `params` resolved
+/// [`super::AssetSharpness::with_sources`] (without the sources there are no rows).
 pub fn explain_rows(params: &EdgeParams, topo: &Topology) -> Vec<ExplainRow> {
+    debug_assert_eq!(
+        params.sources.len(),
+        params.h.len(),
+        "resolved with sources"
+    );
     topo.edges()
         .zip(params.h.iter().zip(&params.sources))
         .enumerate()

@@ -113,6 +113,8 @@ pub struct EdgeParams {
     /// non-manifold and degenerate ones. Decided once here; the surfaces, the tessellator's
     /// creases, the morph targets and the report all read it.
     pub effective: EffectiveH,
+    /// Which source set each edge's h: one per edge when the asset was made
+    /// [`AssetSharpness::with_sources`] (for `--explain-h`), else empty.
     pub sources: Vec<HSource>,
     pub warnings: Vec<SharpnessWarning>,
 }
@@ -158,6 +160,9 @@ pub struct AssetSharpness {
     /// Mesh index → index into `sidecar.meshes`.
     section_of_mesh: HashMap<usize, usize>,
     defaults: Defaults,
+    /// Whether [`EdgeParams::sources`] is filled: only `--explain-h` reads it, and at 32 bytes
+    /// per edge it is not built otherwise.
+    keep_sources: bool,
 }
 
 impl AssetSharpness {
@@ -200,7 +205,15 @@ impl AssetSharpness {
             sidecar,
             section_of_mesh,
             defaults,
+            keep_sources: false,
         })
+    }
+
+    /// The same, resolving each edge's [`HSource`] too (for `--explain-h`); without it
+    /// [`EdgeParams::sources`] is empty.
+    pub fn with_sources(mut self) -> Self {
+        self.keep_sources = true;
+        self
     }
 
     /// The per-asset tessellation level from the sidecar, if it sets one.
@@ -223,6 +236,22 @@ impl AssetSharpness {
             Some(&s) => sc.meshes[s].density.apply(asset),
             None => asset,
         }
+    }
+
+    /// The options of each level of mesh `mesh`'s LOD chain, finest first (empty without a
+    /// chain): the chain's level ([`crate::options::Options::lod_levels`]) under the sidecar's
+    /// density keys as in [`Self::mesh_options`]. A block that decides its scope's density
+    /// fixes it at every level, so such a mesh's levels are all one (written once).
+    pub fn mesh_lod_levels(
+        &self,
+        mesh: usize,
+        options: &crate::options::Options,
+    ) -> Vec<crate::options::Options> {
+        options
+            .lod_levels()
+            .iter()
+            .map(|level| self.mesh_options(mesh, level))
+            .collect()
     }
 
     /// Whether the sidecar sets a density key anywhere (then meshes may differ in density).

@@ -97,56 +97,71 @@ pub(crate) fn resolve(
     };
 
     // Edges are independent: resolved in parallel, collected in edge order.
-    let (h, (effective, sources)): (Vec<f64>, (Vec<f64>, Vec<HSource>)) = topo
-        .par_edges()
-        .enumerate()
-        .map(|(e, edge)| {
-            let id = EdgeId(e as u32);
-            // The primitives on the edge's sides, read straight from its uses: the sharpest
-            // value wins, ties going to the lowest primitive (triangles outside every
-            // primitive first), whatever the order of the uses.
-            let sides = || edge.tris.iter().map(|u| prim_of_tri[u.at().0]);
-            let (value, source) = if let Some(x) = sidecar_edges.get(&id) {
-                (x.value, HSource::SidecarEdge(x.at.clone()))
-            } else if let Some(x) = prim_edges.get(&id) {
-                (x.value, HSource::PrimitiveExtrasEdge(x.at.clone()))
-            } else if let Some(x) = mesh_edges.get(&id) {
-                (x.value, HSource::MeshExtrasEdge(x.at.clone()))
-            } else if let Some(rule) = crease_rule(
-                &edge,
-                topo,
-                sharpest(sides(), |p| {
-                    side_crease(p).map_or(asset.defaults.crease_angle, |a| a.value)
-                })
-                .and_then(side_crease),
-                asset.defaults.crease_angle,
-            ) {
-                (0.0, rule)
-            } else if asset.defaults.keep_hard_edges && is_hard_edge(&edge) {
-                (0.0, HSource::HardEdge)
-            } else if let Some(x) = section.and_then(|b| b.h.as_ref()) {
-                (x.value, HSource::SidecarMeshDefault(x.at.clone()))
-            } else if let Some((x, on_prim)) =
-                sharpest(sides().filter(|&p| side_h(p).is_some()), |p| {
-                    side_h(p).map_or(f64::INFINITY, |x| x.0.value)
-                })
-                .and_then(side_h)
-            {
-                let at = x.at.clone();
-                let source = if on_prim {
-                    HSource::PrimitiveExtrasDefault(at)
-                } else {
-                    HSource::MeshExtrasDefault(at)
-                };
-                (x.value, source)
-            } else if let Some(x) = sidecar_asset.and_then(|b| b.h.as_ref()) {
-                (x.value, HSource::SidecarAssetDefault(x.at.clone()))
-            } else {
-                (asset.defaults.h, HSource::Options)
-            };
-            (value, (EffectiveH::of_edge(edge.kind, value), source))
+    let source_of = |(e, edge): (usize, Edge<'_>)| {
+        let id = EdgeId(e as u32);
+        // The primitives on the edge's sides, read straight from its uses: the sharpest
+        // value wins, ties going to the lowest primitive (triangles outside every
+        // primitive first), whatever the order of the uses.
+        let sides = || edge.tris.iter().map(|u| prim_of_tri[u.at().0]);
+        let (value, source) = if let Some(x) = sidecar_edges.get(&id) {
+            (x.value, HSource::SidecarEdge(x.at.clone()))
+        } else if let Some(x) = prim_edges.get(&id) {
+            (x.value, HSource::PrimitiveExtrasEdge(x.at.clone()))
+        } else if let Some(x) = mesh_edges.get(&id) {
+            (x.value, HSource::MeshExtrasEdge(x.at.clone()))
+        } else if let Some(rule) = crease_rule(
+            &edge,
+            topo,
+            sharpest(sides(), |p| {
+                side_crease(p).map_or(asset.defaults.crease_angle, |a| a.value)
+            })
+            .and_then(side_crease),
+            asset.defaults.crease_angle,
+        ) {
+            (0.0, rule)
+        } else if asset.defaults.keep_hard_edges && is_hard_edge(&edge) {
+            (0.0, HSource::HardEdge)
+        } else if let Some(x) = section.and_then(|b| b.h.as_ref()) {
+            (x.value, HSource::SidecarMeshDefault(x.at.clone()))
+        } else if let Some((x, on_prim)) = sharpest(sides().filter(|&p| side_h(p).is_some()), |p| {
+            side_h(p).map_or(f64::INFINITY, |x| x.0.value)
         })
-        .unzip();
+        .and_then(side_h)
+        {
+            let at = x.at.clone();
+            let source = if on_prim {
+                HSource::PrimitiveExtrasDefault(at)
+            } else {
+                HSource::MeshExtrasDefault(at)
+            };
+            (x.value, source)
+        } else if let Some(x) = sidecar_asset.and_then(|b| b.h.as_ref()) {
+            (x.value, HSource::SidecarAssetDefault(x.at.clone()))
+        } else {
+            (asset.defaults.h, HSource::Options)
+        };
+        (value, EffectiveH::of_edge(edge.kind, value), source)
+    };
+    // The sources (32 bytes per edge) are kept only for `--explain-h`.
+    let (h, (effective, sources)): (Vec<f64>, (Vec<f64>, Vec<HSource>)) = if asset.keep_sources {
+        topo.par_edges()
+            .enumerate()
+            .map(|e| {
+                let (value, effective, source) = source_of(e);
+                (value, (effective, source))
+            })
+            .unzip()
+    } else {
+        let (h, effective) = topo
+            .par_edges()
+            .enumerate()
+            .map(|e| {
+                let (value, effective, _) = source_of(e);
+                (value, effective)
+            })
+            .unzip();
+        (h, (effective, Vec::new()))
+    };
     Ok(EdgeParams {
         h,
         effective: EffectiveH::from_rule(effective),

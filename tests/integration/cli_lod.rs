@@ -357,6 +357,78 @@ fn sidecar_density_keys_per_asset_and_per_mesh() {
     assert!(capped.meshes[0].adaptive.as_ref().unwrap().max_segments <= 3);
 }
 
+/// Under a LOD chain the sidecar's density keys apply to every level as to one: a block that
+/// decides its mesh's density (here a section's `level`, then the top level's tolerance) fixes
+/// it at every level, written once; `max_segments` alone leaves the chain's levels.
+#[test]
+fn sidecar_density_keys_under_a_lod_chain() {
+    let dir = corpus::temp_dir();
+    let input = cylinder_asset(dir.path());
+    let sidecar = dir.path().join("cyl.g2tess.toml");
+    let out = dir.path().join("o.gltf");
+
+    std::fs::write(&sidecar, "[mesh.\"cyl\"]\nlevel = 2\n").unwrap();
+    let report = process_file(&input, &out, &lod_options()).unwrap();
+    let levels = &report.meshes[0].lod;
+    assert_eq!(levels.len(), 3);
+    for level in levels {
+        assert_eq!(level.triangles, report.triangles_in * 4, "{levels:?}");
+    }
+    // One mesh in the file: the coarser levels' nodes show the finest level's mesh.
+    let json = json_of(&out);
+    assert_eq!(json["meshes"].as_array().unwrap().len(), 1);
+    assert!(levels.iter().all(|l| l.mesh == Some(0)), "{levels:?}");
+    assert_eq!(mesh_shape(&out, 0).0, report.triangles_in * 4);
+
+    std::fs::write(&sidecar, "tolerance = 0.02\n").unwrap();
+    let report = process_file(&input, &out, &lod_options()).unwrap();
+    let levels = &report.meshes[0].lod;
+    assert_eq!(levels.len(), 3);
+    for level in levels {
+        assert_eq!(level.figures.tolerance, 0.02);
+        assert_eq!(level.triangles, levels[0].triangles);
+        assert!(level.figures.chord_error.unwrap() <= 0.02 * (1.0 + 1e-9));
+    }
+
+    std::fs::write(&sidecar, "max_segments = 64\n").unwrap();
+    let report = process_file(&input, &out, &lod_options()).unwrap();
+    let levels = &report.meshes[0].lod;
+    let tolerances: Vec<f64> = levels.iter().map(|l| l.figures.tolerance).collect();
+    assert_eq!(tolerances, TOLERANCES);
+}
+
+/// `--max-triangles` bounds the sum of a chain's levels (the file holds them all), not each
+/// level alone.
+#[test]
+fn max_triangles_counts_every_level_of_a_chain() {
+    let dir = corpus::temp_dir();
+    let input = cylinder_asset(dir.path());
+    let out = dir.path().join("o.glb");
+    let free = process_file(&input, &out, &lod_options()).unwrap();
+    let sum: usize = free.meshes[0].lod.iter().map(|l| l.triangles).sum();
+    let finest = free.meshes[0].lod[0].triangles;
+    assert!(
+        sum - 1 >= finest,
+        "the test needs the finest level under the limit"
+    );
+
+    let mut options = lod_options();
+    options.max_output_triangles = sum as u64;
+    let fits = process_file(&input, &out, &options).unwrap();
+    assert_eq!(fits.triangles_out, free.triangles_out);
+
+    options.max_output_triangles = sum as u64 - 1;
+    let e = process_file(&input, &out, &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!(
+            "levels 0 to 2 of its LOD chain would get {sum} triangles"
+        )) && e.contains("--max-triangles"),
+        "{e}"
+    );
+}
+
 #[test]
 fn density_and_lod_range_errors_are_located() {
     let dir = corpus::temp_dir();

@@ -264,6 +264,46 @@ fn an_entry_on_a_boundary_edge_names_the_sidecar_line_and_the_edge() {
     );
 }
 
+/// No surface the pipeline builds says "h > 0 asked for on … edge(s); they use h = 0" (the
+/// warning kind `blend_ignored` was removed): the widths it is built from are already 0 on
+/// boundary, non-manifold and degenerate edges, and an entry naming one is reported where it
+/// is resolved. A book (non-manifold edge), a zero-area triangle and open edges, every edge
+/// asked for h > 0, under every scheme.
+#[test]
+fn edges_the_surface_cannot_blend_are_reported_once_by_their_entry() {
+    let dir = corpus::temp_dir();
+    let p = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 1.0, 0.0],
+        [0.5, -0.5, 0.8],
+        [0.5, -0.5, -0.8],
+        [2.0, 0.0, 0.0],
+    ];
+    let i = [0, 1, 2, 1, 0, 3, 0, 1, 4, 1, 5, 5];
+    let input = write(dir.path(), &p, None, &i);
+    let sidecar = dir.path().join("t.g2tess.toml");
+    std::fs::write(
+        &sidecar,
+        "h = 0.3\n[mesh.0]\nedges = [{ a = 0, b = 2, h = 0.1 }]\n",
+    )
+    .unwrap();
+    for scheme in ["g2", "pn", "hybrid", "coons"] {
+        let all = details(&input, &["--scheme", scheme]);
+        let kinds: Vec<&str> = all.iter().map(|w| w["kind"].as_str().unwrap()).collect();
+        assert!(kinds.contains(&"non_manifold_edges"), "{scheme}: {kinds:?}");
+        assert!(
+            kinds.contains(&"degenerate_triangles"),
+            "{scheme}: {kinds:?}"
+        );
+        assert_eq!(one(&all, "unblended_edge_entry")["edge_kind"], "boundary");
+        for w in &all {
+            let message = w["message"].as_str().unwrap();
+            assert!(!message.contains("they use h = 0"), "{scheme}: {message}");
+        }
+    }
+}
+
 /// Two triangles on the edge 0-1 over the four points `p` with normals `n`, with morph targets
 /// given as four position deltas then four normal deltas.
 fn hinge_with_targets(

@@ -341,6 +341,23 @@ fn hard_edges_are_sharp_only_when_kept() {
     assert_eq!(r.params.sources[r.edge(O, X).0 as usize], HSource::HardEdge);
 }
 
+/// Which source set each edge's h (32 bytes per edge) is resolved only for `--explain-h`:
+/// without it the list is empty and the widths are the same.
+#[test]
+fn sources_are_kept_only_when_asked_for() {
+    let mut case = Case::new(hinge_two_prims(20.0))
+        .mesh_extras(json!({"g2tess": {"h": 0.2}}))
+        .sidecar("[mesh.0]\nedges = [{ from = [0, 0, 0], to = [1, 0, 0], h = 0.1 }]\n");
+    let with = case.run().unwrap();
+    assert_eq!(with.params.sources.len(), with.topo.edge_count());
+    case.sources = false;
+    let without = case.run().unwrap();
+    assert!(without.params.sources.is_empty());
+    assert_eq!(without.params.h, with.params.h);
+    assert_eq!(without.params.effective, with.params.effective);
+    assert_eq!(without.params.warnings, with.params.warnings);
+}
+
 #[test]
 fn shared_edge_takes_the_sharper_primitive_default() {
     let r = Case::new(hinge_two_prims(0.0))

@@ -116,6 +116,8 @@ pub struct Case {
     pub prim_extras: Vec<Option<Value>>,
     pub defaults: Defaults,
     pub mesh_names: Vec<Option<&'static str>>,
+    /// Resolve which source set each edge (`--explain-h`'s data); on unless a test turns it off.
+    pub sources: bool,
 }
 
 impl Case {
@@ -127,6 +129,7 @@ impl Case {
             prim_extras: Vec::new(),
             defaults: defaults(),
             mesh_names: vec![Some("Body")],
+            sources: true,
         }
     }
 
@@ -152,8 +155,12 @@ impl Case {
             .map(|text| Sidecar::parse(Path::new(SIDECAR), text))
             .transpose()
             .map_err(|e| e.to_string())?;
-        let asset = AssetSharpness::new(Path::new(ASSET), sidecar, &self.mesh_names, self.defaults)
-            .map_err(|e| e.to_string())?;
+        let mut asset =
+            AssetSharpness::new(Path::new(ASSET), sidecar, &self.mesh_names, self.defaults)
+                .map_err(|e| e.to_string())?;
+        if self.sources {
+            asset = asset.with_sources();
+        }
         let prims: Vec<PrimitiveContext> = self
             .fixture
             .prims
