@@ -33,7 +33,8 @@ const SHARED_NODE_KEYS: [&str; 6] = [
     "weights",
 ];
 
-/// `name_LOD3`, the suffix Unity's and Unreal's importers group levels by; unnamed: `LOD3`.
+/// `name_LOD3`, the suffix Unity's model importer groups levels by within one model (glTF
+/// importers read `MSFT_lod` instead; the name still says which is which); unnamed: `LOD3`.
 pub fn lod_name(name: Option<&str>, level: usize) -> String {
     match name {
         Some(n) => format!("{n}_LOD{level}"),
