@@ -13,7 +13,9 @@
 //! - `.glb`: the JSON chunk comes first, and its length is known only at the end (accessor
 //!   bounds, counts). The binary chunk is written to a second temporary file beside the output
 //!   and, once the JSON is known, copied behind it by the kernel (`copy_file_range`, no pass
-//!   through this process's memory; a reflink on file systems that share blocks). The last
+//!   through this process's memory; a reflink on file systems that share blocks), in 16 MiB
+//!   steps whose blocks are freed from the staging file as each is copied (a punched hole), so
+//!   the binary chunk is never on disk twice (where holes cannot be punched, it briefly is). The last
 //!   mesh's arrays, in memory anyway until the end, are not staged but written behind the copy
 //!   from where they lie: a one-mesh file is written once, as before. The file is byte for byte
 //!   what [`super::write()`] writes; reserving space for the JSON instead would have changed
@@ -388,6 +390,59 @@ mod tests {
         longer.push(0);
         std::fs::write(&path, longer).unwrap();
         assert_eq!(check(&mut triangle()), Some(path.clone()));
+    }
+
+    /// A `.glb`'s staged binary data is freed step by step as it is copied behind the JSON, so
+    /// the output never needs it twice on disk; the copy is byte for byte.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn staged_bytes_are_freed_as_they_are_copied() {
+        use std::os::unix::fs::MetadataExt as _;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.glb");
+        // Two steps and a part of a third.
+        let data: Vec<u8> = (0..(40u32 << 20)).map(|i| (i % 251) as u8).collect();
+        let mut spool = Staging::aside(&path).unwrap();
+        spool.write(&data).unwrap();
+        let spool = spool.written_out().unwrap();
+        spool.as_file().sync_all().unwrap();
+        let probe = spool.reopen().unwrap();
+        let allocated = || probe.metadata().unwrap().blocks() * 512;
+        let before = allocated();
+        assert!(before >= data.len() as u64, "{before}");
+
+        let mut out = Staging::new(&path).unwrap();
+        out.copy_from(spool, data.len() as u64).unwrap();
+        let after = allocated();
+        let copied = out.finish().unwrap();
+        assert!(
+            std::fs::read(copied.path()).unwrap() == data,
+            "copy differs"
+        );
+        if after == before {
+            // A file system that cannot punch holes (the blocks are freed when it is removed).
+            // SAFETY: a valid descriptor; the call reads no memory of ours.
+            let punched = unsafe {
+                use std::os::fd::AsRawFd as _;
+                libc::fallocate(
+                    probe.as_raw_fd(),
+                    libc::FALLOC_FL_PUNCH_HOLE | libc::FALLOC_FL_KEEP_SIZE,
+                    0,
+                    4096,
+                )
+            };
+            if punched != 0 {
+                eprintln!(
+                    "skipped: the file system of {} punches no holes",
+                    dir.path().display()
+                );
+                return;
+            }
+        }
+        assert!(
+            after < 1 << 20,
+            "{after} bytes of the staged data still allocated"
+        );
     }
 
     #[test]

@@ -356,25 +356,38 @@ impl Staging {
     }
 
     /// Appends the first `len` bytes of the finished staging file `from`, copied by the kernel
-    /// (no pass through this process's memory).
+    /// (no pass through this process's memory), in steps: each step's blocks are freed from
+    /// `from` once copied, so the bytes are on disk twice by one step at most, not whole.
     pub fn copy_from(&mut self, from: tempfile::NamedTempFile, len: u64) -> Result<()> {
         use std::io::{Read as _, Seek as _};
-        let err = |e| Error::io(&self.shown, e);
+        let shown = self.shown.clone();
+        let err = |e| Error::io(&shown, e);
         self.out.flush().map_err(err)?;
         let mut src = from.reopen().map_err(err)?;
         src.rewind().map_err(err)?;
-        let copied = std::io::copy(&mut (&mut src).take(len), self.out.get_mut().as_file_mut())
-            .map_err(err)?;
-        if copied != len {
-            return Err(Error::io(
-                &self.shown,
-                std::io::Error::new(
-                    std::io::ErrorKind::UnexpectedEof,
-                    format!("its staged data ended after {copied} of {len} bytes"),
-                ),
-            ));
+        let mut done = 0u64;
+        while done < len {
+            let step = (len - done).min(WRITEBACK_STEP as u64);
+            let copied =
+                std::io::copy(&mut (&mut src).take(step), self.out.get_mut().as_file_mut())
+                    .map_err(err)?;
+            if copied != step {
+                return Err(Error::io(
+                    &self.shown,
+                    std::io::Error::new(
+                        std::io::ErrorKind::UnexpectedEof,
+                        format!(
+                            "its staged data ended after {} of {len} bytes",
+                            done + copied
+                        ),
+                    ),
+                ));
+            }
+            release(from.as_file(), done, step);
+            done += step;
+            self.written += step;
+            self.hand_over(false)?;
         }
-        self.written += len;
         self.hand_over(true)
     }
 
@@ -433,6 +446,30 @@ fn start_writeback(file: &std::fs::File, offset: u64, len: u64) {
 
 #[cfg(not(target_os = "linux"))]
 fn start_writeback(_file: &std::fs::File, _offset: u64, _len: u64) {}
+
+/// Frees the disk blocks of `len` bytes at `offset` of `file` (a staging file whose bytes were
+/// copied and are read no more), keeping its length. Advice only: a file system that cannot
+/// punch holes keeps the blocks until the file is removed, as before.
+#[cfg(target_os = "linux")]
+fn release(file: &std::fs::File, offset: u64, len: u64) {
+    use std::os::fd::AsRawFd as _;
+    let (Ok(offset), Ok(len)) = (i64::try_from(offset), i64::try_from(len)) else {
+        return;
+    };
+    // SAFETY: the descriptor belongs to `file`, open for the duration of the call; the call
+    // reads no memory of ours.
+    unsafe {
+        libc::fallocate(
+            file.as_raw_fd(),
+            libc::FALLOC_FL_PUNCH_HOLE | libc::FALLOC_FL_KEEP_SIZE,
+            offset,
+            len,
+        );
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn release(_file: &std::fs::File, _offset: u64, _len: u64) {}
 
 /// The output JSON before repacking: the document as read, with the typed model's changes,
 /// the primitives in `replaced` and the dequantizing nodes; and the typed model alone.
