@@ -153,18 +153,22 @@ fn normals_facing_away_and_opposite_winding_are_located() {
     assert_eq!((&w["count"], &w["edges"]), (&json!(3), &json!(expected)));
 }
 
-#[test]
-fn non_manifold_edges_and_bow_ties_are_located() {
-    let dir = corpus::temp_dir();
-    // A book: three triangles on the edge 0-1.
-    let p = [
+/// A book: three triangles on the edge 0-1.
+const BOOK: ([[f32; 3]; 5], [u32; 9]) = (
+    [
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],
         [0.5, 1.0, 0.0],
         [0.5, -0.5, 0.8],
         [0.5, -0.5, -0.8],
-    ];
-    let i = [0, 1, 2, 1, 0, 3, 0, 1, 4];
+    ],
+    [0, 1, 2, 1, 0, 3, 0, 1, 4],
+);
+
+#[test]
+fn non_manifold_edges_and_bow_ties_are_located() {
+    let dir = corpus::temp_dir();
+    let (p, i) = BOOK;
     let all = details(&write(dir.path(), &p, None, &i), &[]);
     let w = one(&all, "non_manifold_edges");
     assert_eq!(
@@ -272,15 +276,9 @@ fn an_entry_on_a_boundary_edge_names_the_sidecar_line_and_the_edge() {
 #[test]
 fn edges_the_surface_cannot_blend_are_reported_once_by_their_entry() {
     let dir = corpus::temp_dir();
-    let p = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [0.5, 1.0, 0.0],
-        [0.5, -0.5, 0.8],
-        [0.5, -0.5, -0.8],
-        [2.0, 0.0, 0.0],
-    ];
-    let i = [0, 1, 2, 1, 0, 3, 0, 1, 4, 1, 5, 5];
+    // The book, and a zero-area triangle on one of its open edges.
+    let p = [BOOK.0.as_slice(), &[[2.0, 0.0, 0.0]]].concat();
+    let i = [BOOK.1.as_slice(), &[1, 5, 5]].concat();
     let input = write(dir.path(), &p, None, &i);
     let sidecar = dir.path().join("t.g2tess.toml");
     std::fs::write(
