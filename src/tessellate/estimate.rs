@@ -9,9 +9,13 @@
 //! S(Σ w_a λ_a) − Σ w_a S(λ_a) = −½ Σ_{a<b} w_a w_b Q_ab,   Q_ab = D²S[λ_a − λ_b, λ_a − λ_b]
 //! ```
 //!
-//! (vector valued, so opposite curvatures cancel as they do on the surface). `D²S` is fixed by
-//! its values along the three lattice directions, and the second differences of a level-`L`
-//! lattice give those at every interior point: `S(p − u) − 2S(p) + S(p + u) = D²S[u, u] + O(|u|⁴)`.
+//! (so opposite curvatures cancel as they do on the surface). `D²S` is fixed by its values
+//! along the three lattice directions, and the second differences of a level-`L` lattice give
+//! those at every interior point: `S(p − u) − 2S(p) + S(p + u) = D²S[u, u] + O(|u|⁴)`. Only their
+//! component along the surface normal `n(p)` is kept, as `chord.rs` measures the error along the
+//! normal: the tangential part of `D²S` is the parametrization's curvature, not the surface's,
+//! and near the G² blend's corners it grows as one over the distance to the corner (see
+//! `chord.rs`), which would ask for counts the surface does not need.
 //! So one lattice per source triangle predicts the error of every output triangle at the seven
 //! sample points `chord.rs` measures, from the second differences at the lattice points nearest
 //! its corners: exactly on quadratic surfaces, and at the pattern's own resolution (`L` is at
@@ -26,11 +30,12 @@ use super::transition::Pattern;
 use crate::surface::{lattice_index, SurfacePoint};
 
 /// Second differences of a level-`L` lattice at its interior points (`i, j ≥ 1`, `i + j < L`),
-/// in interior lattice order: along `i`, along `j`, and along `(i − 1, j + 1)`.
+/// along the surface normal there, in interior lattice order: along `i`, along `j`, and along
+/// `(i − 1, j + 1)`.
 #[derive(Debug, Default)]
 pub(crate) struct Curvature {
     level: u32,
-    at: Vec<[DVec3; 3]>,
+    at: Vec<[f64; 3]>,
 }
 
 /// Index of interior point `(i, j)` of the level-`n` lattice among the interior points, in
@@ -50,11 +55,13 @@ impl Curvature {
         let at = |i: u32, j: u32| points[lattice_index(level, i, j)].position;
         for j in 1..level {
             for i in 1..level - j {
-                let centre = 2.0 * at(i, j);
+                let p = &points[lattice_index(level, i, j)];
+                let centre = 2.0 * p.position;
+                let along = |d: DVec3| d.dot(p.normal);
                 self.at.push([
-                    at(i - 1, j) - centre + at(i + 1, j),
-                    at(i, j - 1) - centre + at(i, j + 1),
-                    at(i + 1, j - 1) - centre + at(i - 1, j + 1),
+                    along(at(i - 1, j) - centre + at(i + 1, j)),
+                    along(at(i, j - 1) - centre + at(i, j + 1)),
+                    along(at(i + 1, j - 1) - centre + at(i - 1, j + 1)),
                 ]);
             }
         }
@@ -88,13 +95,13 @@ impl Curvature {
         for j in 1..l {
             for i in 1..l - j {
                 if inside(i, j) {
-                    worst = worst.max(worst_squared(self.at[index]));
+                    worst = worst.max(worst_abs(self.at[index]));
                 }
                 index += 1;
             }
         }
         let scale = (f64::from(l) / f64::from(m)).powi(2);
-        scale * worst.sqrt()
+        scale * worst
     }
 
     /// The predicted error of one output triangle of `model`, at the second differences of
@@ -114,20 +121,18 @@ impl Curvature {
             let q = t
                 .edges
                 .map(|[ii, jj, ij]| l2 * (ii * d1 + jj * d2 + ij * mixed));
-            worst = worst.max(worst_squared(q));
+            worst = worst.max(worst_abs(q));
         }
-        worst.sqrt()
+        worst
     }
 }
 
-/// The largest squared error over the sample weights for `q = [Q_01, Q_12, Q_02]`.
+/// The largest error over the sample weights for `q = [Q_01, Q_12, Q_02]` (normal components).
 #[inline]
-fn worst_squared(q: [DVec3; 3]) -> f64 {
+fn worst_abs(q: [f64; 3]) -> f64 {
     WEIGHTS
         .iter()
-        .map(|w| {
-            (0.5 * (w[0] * w[1] * q[0] + w[1] * w[2] * q[1] + w[0] * w[2] * q[2])).length_squared()
-        })
+        .map(|w| (0.5 * (w[0] * w[1] * q[0] + w[1] * w[2] * q[1] + w[0] * w[2] * q[2])).abs())
         .fold(0.0, f64::max)
 }
 

@@ -97,7 +97,7 @@ fn measured_chord_error_meets_the_tolerance_on_known_curvature() {
         ("icosphere 320", icosphere(3), &[3e-3, 3e-4]),
         ("torus 12", torus(12), &[1e-2, 3e-3]),
         ("bumpy sphere", bumpy_sphere(), &[1e-2, 1e-3]),
-        ("height field", height_field(6), &[1e-2, 1e-3]),
+        ("height field", height_field(6), &[1e-2, 1e-3, 1e-4]),
         ("plate with dome", plate_with_dome(), &[1e-2, 1e-3]),
     ];
     for (name, mesh, tolerances) in &meshes {
@@ -129,6 +129,39 @@ fn a_sphere_needs_the_uniform_count_its_curvature_predicts() {
     let edges: Vec<u32> = r.counts.edges.clone();
     let (lo, hi) = (edges.iter().min().unwrap(), edges.iter().max().unwrap());
     assert!(*lo >= 2 && *hi <= 5, "edge counts {lo}..{hi}");
+}
+
+#[test]
+fn the_measured_chord_error_of_a_sphere_falls_as_one_over_the_level_squared() {
+    // The surface is smooth and within 2.1e-7 of the unit sphere on this 5,120-triangle
+    // icosphere, so the flat triangles' distance from it must fall as 1/n² (the remainder is
+    // O(1/n⁴), under 2% of the ratio from level 4 on; measured 4.00 and 3.98). The distance to
+    // the surface point of the same parameter, measured before, fell only 3.1e-4, 2.9e-4,
+    // 1.6e-4: the blend's parametrization near the corners, which is no distance from the
+    // surface.
+    let mesh = icosphere(4);
+    let topo = Topology::build(&mesh);
+    let hs = h_all(&topo, 0.212);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let group = 0..mesh.triangles.len();
+    let error = |level: u32| {
+        let counts = SegmentCounts::uniform(&topo, level);
+        let dense = tessellate(
+            &mesh,
+            &topo,
+            &hs,
+            &surface,
+            level,
+            std::slice::from_ref(&group),
+        );
+        chord_error(&topo, &surface, &counts, group.clone(), &dense[0])
+    };
+    let e = [4, 8, 16].map(error);
+    println!("chord error at levels 4, 8, 16: {e:?}");
+    for pair in e.windows(2) {
+        let ratio = pair[0] / pair[1];
+        assert!((3.8..4.2).contains(&ratio), "ratio {ratio} of {e:?}");
+    }
 }
 
 /// The smallest uniform level whose measured chord error is at most `tolerance`, by bisection
