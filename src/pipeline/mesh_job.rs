@@ -21,7 +21,7 @@ use super::warning::{merge_target_warnings, Warning};
 use crate::gltf_io::{self, PrimitiveData};
 use crate::mesh::TriMesh;
 use crate::options::Options;
-use crate::sharpness::{AssetSharpness, EdgeParams, MeshContext, PrimitiveContext};
+use crate::sharpness::{AssetSharpness, EdgeParams, EffectiveH, MeshContext, PrimitiveContext};
 use crate::surface::{scheme, Surface};
 use crate::topology::Topology;
 use crate::{normals, optimize};
@@ -382,7 +382,7 @@ pub(super) fn build_surface(
     options: &Options,
     mesh: &TriMesh,
     topo: &Topology,
-    h: &[f64],
+    h: &EffectiveH,
 ) -> (Box<dyn Surface>, Vec<scheme::Warning>) {
     let params = options.scheme_params();
     scheme::build_surface(options.scheme, mesh, topo, h, &params)

@@ -4,6 +4,7 @@
 
 use crate::support::*;
 use g2tess::surface::{lattice_bary, G2Surface, Nets, PnSurface, Profile, Surface, H_MAX};
+use g2tess::sharpness::EffectiveH;
 use g2tess::topology::Topology;
 use glam::DVec3;
 
@@ -62,7 +63,7 @@ fn flat_mesh_with_equal_normals_stays_exactly_flat() {
     let mut rng = Lcg(5);
     let h: Vec<f64> = topo.edges().map(|_| rng.next() * H_MAX).collect();
     for profile in [Profile::Paper, Profile::C2] {
-        let s = G2Surface::new(&mesh, &topo, &h, profile);
+        let s = G2Surface::new(&mesh, &topo, &widths(&topo, &h), profile);
         for t in 0..mesh.triangles.len() {
             let mut out = Vec::new();
             s.evaluate_lattice(t, 9, &mut out);
@@ -105,7 +106,7 @@ fn lattice_evaluation_equals_point_evaluation() {
         .edges()
         .map(|_| (rng.next() * 4.0).floor() * 0.1)
         .collect();
-    let s = G2Surface::new(&mesh, &topo, &h, Profile::C2);
+    let s = G2Surface::new(&mesh, &topo, &widths(&topo, &h), Profile::C2);
     for level in [1, 4, 7] {
         for t in 0..mesh.triangles.len() {
             let mut out = Vec::new();
@@ -150,8 +151,8 @@ fn reordering_corners_or_flipping_triangles_does_not_move_the_surface() {
             let h1: Vec<f64> = topo.edges().map(|e| h_of(&topo, &e)).collect();
             let h2: Vec<f64> = topo2.edges().map(|e| h_of(&topo2, &e)).collect();
             for profile in [Profile::Paper, Profile::C2] {
-                let s1 = G2Surface::new(&mesh, &topo, &h1, profile);
-                let s2 = G2Surface::new(&re.mesh, &topo2, &h2, profile);
+                let s1 = G2Surface::new(&mesh, &topo, &widths(&topo, &h1), profile);
+                let s2 = G2Surface::new(&re.mesh, &topo2, &widths(&topo2, &h2), profile);
                 let mut worst: f64 = 0.0;
                 for t in 0..mesh.triangles.len() {
                     for _ in 0..10 {
@@ -172,12 +173,12 @@ fn reordering_corners_or_flipping_triangles_does_not_move_the_surface() {
 fn h_is_clamped_and_unblendable_edges_are_reported() {
     let mesh = height_field(3);
     let topo = Topology::build(&mesh);
-    let s = G2Surface::new(&mesh, &topo, &h_all(&topo, 5.0), Profile::C2);
+    let (h, ignored) = EffectiveH::from_requested(&topo, &vec![5.0; topo.edge_count()]);
     let boundary = topo
         .edges()
         .filter(|e| e.kind == g2tess::topology::EdgeKind::Boundary)
         .count();
-    for (e, &h) in topo.edges().zip(s.effective_h()) {
+    for (e, &h) in topo.edges().zip(h.iter()) {
         let want = if e.kind == g2tess::topology::EdgeKind::Interior {
             H_MAX
         } else {
@@ -186,7 +187,13 @@ fn h_is_clamped_and_unblendable_edges_are_reported() {
         assert_eq!(h, want);
     }
     assert!(matches!(
-        s.warnings(),
-        [g2tess::topology::Warning::BlendIgnored { kind: g2tess::topology::EdgeKind::Boundary, edges, .. }] if *edges == boundary
+        ignored[..],
+        [g2tess::topology::Warning::BlendIgnored { kind: g2tess::topology::EdgeKind::Boundary, edges, .. }] if edges == boundary
     ));
+    // The widest blend the surface is ever given: every point is finite and unit-normal.
+    let s = G2Surface::new(&mesh, &topo, &h, Profile::C2);
+    for t in 0..mesh.triangles.len() {
+        let p = s.evaluate(t, [0.2, 0.3, 0.5]);
+        assert!(p.position.is_finite() && (p.normal.length() - 1.0).abs() < 1e-12);
+    }
 }
