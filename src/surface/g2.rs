@@ -56,6 +56,13 @@ struct Patch {
     /// The effective width of the edge opposite each corner: kept here rather than read through
     /// an edge index, so the surface needs no copy of the per-edge widths.
     widths: [f64; 3],
+    /// Bit `m − 3` set: edge point `m` is an average of split-normal curves (PN-AEN), used as
+    /// stored. Every other edge point lies in its corner's tangent plane (both net rules put it
+    /// there), and is put back into it exactly when the net is rebuilt ([`local`]): the `f32`
+    /// offset would otherwise tilt each patch's tangent plane at a corner by up to `6e-8` rad,
+    /// differently in each triangle around a vertex, and the surface would no longer be G1 at
+    /// the vertex to rounding.
+    as_stored: u8,
 }
 
 /// The bytes a [`Patch`] takes: pinned, since the surface's memory per triangle is a figure the
@@ -220,6 +227,7 @@ impl G2Surface {
                     verts,
                     across,
                     widths,
+                    as_stored: 0,
                 }
             })
             .collect();
@@ -391,7 +399,7 @@ fn face_fallback(p: [DVec3; 3]) -> DVec3 {
 #[inline]
 fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
     let (position, normal) = corners(vertices, patch.verts);
-    let net = std::array::from_fn(|x| {
+    let mut net = std::array::from_fn(|x| {
         let p = coordinate(&position, x);
         let mut coord = [0.0; 10];
         coord[..3].copy_from_slice(&p);
@@ -400,19 +408,36 @@ fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
         }
         coord
     });
+    onto_tangent_planes(&mut net, &normal, patch.as_stored);
     Local { net, normal }
 }
 
 /// Edge control point `slot` of `patch`, as [`local`] rebuilds it.
 fn edge_point(vertices: &[CornerVertex], patch: &Patch, slot: usize) -> DVec3 {
-    let [c, e] = NEAR_OF[slot - 3];
-    let (pc, pe) = (
-        vertices[patch.verts[c] as usize].position,
-        vertices[patch.verts[e] as usize].position,
-    );
-    DVec3::from_array(std::array::from_fn(|x| {
-        (2.0 * pc[x] + pe[x]) / 3.0 + f64::from(patch.inner[x][slot - 3])
-    }))
+    let net = local(vertices, patch).net;
+    DVec3::new(net[0][slot], net[1][slot], net[2][slot])
+}
+
+/// Moves the edge points of `net` that lie in their corner's tangent plane (all but those in
+/// `as_stored`) back into it: `b ← b − ((b − p_c)·n_c) n_c`. Both triangles of an edge do the
+/// same arithmetic on the same corner and offsets, so shared curves stay shared bit for bit.
+#[inline]
+fn onto_tangent_planes(net: &mut SoaNet, normal: &[DVec3; 3], as_stored: u8) {
+    for (m, &[c, _]) in NEAR_OF.iter().enumerate() {
+        if as_stored & (1 << m) != 0 {
+            continue;
+        }
+        let slot = m + 3;
+        let v = DVec3::new(
+            net[0][slot] - net[0][c],
+            net[1][slot] - net[1][c],
+            net[2][slot] - net[2][c],
+        );
+        let d = v.dot(normal[c]);
+        for (x, coord) in net.iter_mut().enumerate() {
+            coord[slot] = coord[c] + (v[x] - d * normal[c][x]);
+        }
+    }
 }
 
 /// Stores `value` as control point `slot` (3 to 9) of `patch`.
@@ -619,6 +644,7 @@ fn share_unblended_edge_curves(
         for (t, s) in uses(topo.edge(EdgeId(e as u32))) {
             for (slot, value) in s.into_iter().zip(avg) {
                 set_point(vertices, &mut patches[t], slot, value);
+                patches[t].as_stored |= 1 << (slot - 3);
             }
             touched.push(t as u32);
         }
