@@ -211,7 +211,7 @@ pub fn smooth_mesh(
     let mut primitives = Vec::new();
     let mut lods = Vec::new();
     let mut previous_counts = None;
-    // The G² surface holds about 240 bytes per input triangle: freed once the last level is
+    // The G² surface holds about 160 bytes per input triangle: freed once the last level is
     // tessellated, before its attributes are carried, when the dense mesh is at its largest.
     let mut surface = Some(surface);
     let last = levels.len() - 1;
