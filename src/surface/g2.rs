@@ -403,8 +403,8 @@ fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
         let p = coordinate(&position, x);
         let mut coord = [0.0; 10];
         coord[..3].copy_from_slice(&p);
-        for m in 3..10 {
-            coord[m] = flat_point(p, m) + f64::from(patch.inner[x][m - 3]);
+        for (m, (point, &offset)) in coord[3..].iter_mut().zip(&patch.inner[x]).enumerate() {
+            *point = flat_point(p, 3 + m) + f64::from(offset);
         }
         coord
     });
