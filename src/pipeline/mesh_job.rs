@@ -21,7 +21,7 @@ use super::warning::{merge_target_warnings, Warning};
 use crate::gltf_io::{self, PrimitiveData};
 use crate::mesh::TriMesh;
 use crate::options::Options;
-use crate::sharpness::{AssetSharpness, EdgeParams, MeshContext, PrimitiveContext};
+use crate::sharpness::{AssetSharpness, EdgeParams, EffectiveH, MeshContext, PrimitiveContext};
 use crate::surface::{scheme, Surface};
 use crate::topology::Topology;
 use crate::{normals, optimize};
@@ -216,7 +216,7 @@ pub fn smooth_mesh(
     // Every level written is held (and, with MSFT_lod, stored in the one file): the limit is
     // on their sum.
     let mut planned_total = 0u64;
-    // The G² surface holds about 240 bytes per input triangle: freed once the last level is
+    // The G² surface holds about 160 bytes per input triangle: freed once the last level is
     // tessellated, before its attributes are carried, when the dense mesh is at its largest.
     let mut surface = Some(surface);
     let last = levels.len() - 1;
@@ -390,7 +390,7 @@ pub(super) fn build_surface(
     options: &Options,
     mesh: &TriMesh,
     topo: &Topology,
-    h: &[f64],
+    h: &EffectiveH,
 ) -> (Box<dyn Surface>, Vec<scheme::Warning>) {
     let params = options.scheme_params();
     scheme::build_surface(options.scheme, mesh, topo, h, &params)

@@ -16,6 +16,7 @@ use crate::gltf_io::MorphDeltas;
 use crate::mesh::TriMesh;
 use crate::optimize::remap_stream;
 use crate::options::Options;
+use crate::sharpness::EffectiveH;
 use crate::surface::scheme;
 use crate::topology::Topology;
 
@@ -38,7 +39,7 @@ pub struct TargetSurface {
 pub fn targets(
     mesh: &TriMesh,
     topo: &Topology,
-    h: &[f64],
+    h: &EffectiveH,
     prepared: &[Prepared],
     groups: &[Range<usize>],
     density: &Density,

@@ -15,44 +15,115 @@ use super::pn::{compose, Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::sharpness::EffectiveH;
-use crate::topology::{Edge, EdgeId, Topology, TriId, Warning};
+use crate::topology::{Edge, EdgeId, Neighbour, Topology, TriId};
 
 /// A control net by coordinate, `[x, y, z][control point]`: the layout the per-point sums of
 /// [`accumulate`] read, one coordinate of one control point at a time.
 type SoaNet = [[f64; 10]; 3];
 
-/// Everything one triangle needs at evaluation time that no other triangle holds too: 216
+/// Everything one triangle needs at evaluation time that no other triangle holds too: 136
 /// bytes, one allocation for the whole mesh.
 ///
 /// The corners' positions and normals live once per input vertex ([`CornerVertex`]), not
 /// once per use of it: every rule of [`Nets`] copies a corner's position into its net bit for
 /// bit and the shared edge curves leave corners alone, so the net is whole again when a
-/// lattice part asks for it ([`G2Surface::local`]). The widths are read from the surface's
-/// per-edge table through `edges`. Copies of both cost 160 bytes a triangle, and at a million
-/// input triangles every such byte is a page fault at set-up.
+/// lattice part asks for it ([`G2Surface::local`]). At a million input triangles every byte
+/// held here is a page fault at set-up, and the surface is the run's largest allocation.
 #[derive(Debug, Clone)]
 struct Patch {
     /// Control points 3 to 9 of the own net `b_f` (Eq. 2 or the round net, with shared edge
-    /// curves on unblended split edges), by coordinate: the six edge points and `b111`.
-    inner: [[f64; INNER]; 3],
+    /// curves on unblended split edges), by coordinate: the six edge points and `b111`, each as
+    /// its offset from the flat net's point ([`flat_point`]), in `f32`.
+    ///
+    /// The offset is the part of a control point that curvature makes, `O(κ·L²)` for edges of
+    /// length `L`, so `f32` keeps it to about `6e-8` of that (1e-13 of the radius on a
+    /// million-triangle unit sphere) in half the bytes of the point. Both triangles of an edge
+    /// compute the same flat point from the same two corners, so a curve they share is still
+    /// shared bit for bit, and the surface stays watertight exactly as with `f64` points.
+    inner: [[f32; INNER]; 3],
     /// Input vertex of each corner, an index into [`G2Surface::vertices`].
     verts: [u32; 3],
     /// `across[k]`: for a blended edge opposite corner `k` (its width above 0), the neighbour
-    /// and its slots, from which [`G2Surface::across_net`] composes `b_g ∘ M` (Eq. 3) when a
-    /// point needs it; meaningless on other edges.
+    /// and its slots, packed by [`Across::pack`], from which [`G2Surface::across_net`]
+    /// composes `b_g ∘ M` (Eq. 3) when a point needs it; meaningless on other edges.
     ///
     /// The composed nets are not stored: three of them per triangle were two thirds of the
     /// surface's memory (720 of 1128 bytes), more than the dense output of a level-8 triangle,
     /// and composing costs less than the page faults of holding them. Each is composed once per
     /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
     /// still agree bit for bit.
-    across: [Across; 3],
-    /// The welded edge opposite each corner, an index into [`G2Surface::effective_h`].
-    edges: [u32; 3],
+    across: [u32; 3],
+    /// The effective width of the edge opposite each corner: kept here rather than read through
+    /// an edge index, so the surface needs no copy of the per-edge widths.
+    widths: [f64; 3],
+    /// Bit `m − 3` set: edge point `m` is an average of split-normal curves (PN-AEN), used as
+    /// stored. Every other edge point lies in its corner's tangent plane (both net rules put it
+    /// there), and is put back into it exactly when the net is rebuilt ([`local`]): the `f32`
+    /// offset would otherwise tilt each patch's tangent plane at a corner by up to `6e-8` rad,
+    /// differently in each triangle around a vertex, and the surface would no longer be G1 at
+    /// the vertex to rounding.
+    as_stored: u8,
 }
+
+/// The bytes a [`Patch`] takes: pinned, since the surface's memory per triangle is a figure the
+/// pipeline is planned around (the run's peak at a million triangles).
+const _: () = assert!(std::mem::size_of::<Patch>() == 136);
 
 /// Control points of a net that are not corners (the corners are slots 0, 1, 2).
 const INNER: usize = 7;
+
+/// The point of the flat net (the triangle itself as a cubic) in slot `m`:
+/// `(i·p0 + j·p1 + k·p2)/3` for the exponents `(i, j, k)` of [`IJK`](super::pn::IJK).
+///
+/// Written per kind of slot so that an edge point depends on its edge's two corners only and
+/// in the same way from both triangles of the edge (`(2·p_c + p_e)/3`, the corner it is next
+/// to first), whatever the triangles' corner order: the offsets of a shared edge curve are then
+/// equal on both sides, and so are the points rebuilt from them.
+#[inline]
+fn flat_point(p: [f64; 3], m: usize) -> f64 {
+    match m {
+        B111 => (p[0] + p[1] + p[2]) / 3.0,
+        _ => {
+            let [c, e] = NEAR_OF[m - 3];
+            (2.0 * p[c] + p[e]) / 3.0
+        }
+    }
+}
+
+/// `NEAR_OF[m − 3] = [c, e]` for the edge slot `m = NEAR[c][e]` (the inverse of [`NEAR`]).
+const NEAR_OF: [[usize; 2]; 6] = {
+    let mut table = [[0; 2]; 6];
+    let mut c = 0;
+    while c < 3 {
+        let mut e = 0;
+        while e < 3 {
+            if c != e {
+                table[NEAR[c][e] - 3] = [c, e];
+            }
+            e += 1;
+        }
+        c += 1;
+    }
+    table
+};
+
+/// Coordinate `x` of the corners `p`, by corner.
+#[inline]
+fn coordinate(p: &[DVec3; 3], x: usize) -> [f64; 3] {
+    [p[0][x], p[1][x], p[2][x]]
+}
+
+/// `net`'s control points 3 to 9 as the offsets [`Patch::inner`] stores.
+fn offsets(net: &Net) -> [[f32; INNER]; 3] {
+    let mut out = [[0.0; INNER]; 3];
+    for (x, coord) in out.iter_mut().enumerate() {
+        let p = [net[0][x], net[1][x], net[2][x]];
+        for (m, offset) in coord.iter_mut().enumerate() {
+            *offset = (net[3 + m][x] - flat_point(p, 3 + m)) as f32;
+        }
+    }
+    out
+}
 
 /// An input vertex as every triangle on it reads it.
 #[derive(Debug, Clone, Copy)]
@@ -69,11 +140,24 @@ struct Local {
     normal: [DVec3; 3],
 }
 
-/// The triangle across a blended edge and the slots `[p, q, r]` of [`neighbour_map`].
-#[derive(Debug, Clone, Copy, Default)]
-struct Across {
-    tri: u32,
-    slots: [u8; 3],
+/// The triangle across a blended edge and the slots `[p, q, r]` of [`neighbour_map`], packed
+/// into one `u32` as the topology packs its neighbours: the neighbour's use of the edge
+/// (`3·tri + r`) and one bit for which way round `p` and `q` are. Every mesh whose topology
+/// could be built fits.
+struct Across;
+
+impl Across {
+    fn pack(n: Neighbour) -> u32 {
+        let [p, _, r] = n.slots.map(u32::from);
+        (n.tri.0 * 3 + r) * 2 + u32::from(p != (r + 1) % 3)
+    }
+
+    fn unpack(code: u32) -> (usize, [usize; 3]) {
+        let (tri, r) = ((code >> 1) / 3, (code >> 1) % 3);
+        let (p, q) = ((r + 1) % 3, (r + 2) % 3);
+        let (p, q) = if code & 1 == 0 { (p, q) } else { (q, p) };
+        (tri as usize, [p, q, r].map(|s| s as usize))
+    }
 }
 
 /// The G² blended surface of Lee–Hwang–Yoon over a whole mesh, one width `h` per welded edge.
@@ -82,41 +166,35 @@ pub struct G2Surface {
     patches: Vec<Patch>,
     vertices: Vec<CornerVertex>,
     profile: Profile,
-    h_edge: EffectiveH,
-    warnings: Vec<Warning>,
     patterns: PatternCache,
 }
 
 impl G2Surface {
-    /// Builds the surface. `h_per_edge` is indexed by [`EdgeId`](crate::topology::EdgeId) and
-    /// must have one entry per edge of `topo`; values are clamped to `[0, H_MAX]` (NaN to 0).
-    /// Boundary, non-manifold and degenerate edges act as h = 0 (with a warning if h > 0 was
-    /// asked for). Where an edge is not blended but its triangles disagree on its boundary
-    /// curve (split normals), all of them use the average of their edge control points
-    /// (PN-AEN), so the surface stays watertight.
+    /// Builds the surface with the widths `h` the pipeline decided (one per edge of `topo`;
+    /// boundary, non-manifold and degenerate edges are 0 there, so they are PN creases). Where
+    /// an edge is not blended but its triangles disagree on its boundary curve (split normals),
+    /// all of them use the average of their edge control points (PN-AEN), so the surface stays
+    /// watertight.
     ///
     /// # Panics
-    /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
-    pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64], profile: Profile) -> Self {
-        Self::with_nets(mesh, topo, h_per_edge, profile, Nets::default())
+    /// If `h`, `topo` and `mesh` do not belong together (a caller bug).
+    pub fn new(mesh: &TriMesh, topo: &Topology, h: &EffectiveH, profile: Profile) -> Self {
+        Self::with_nets(mesh, topo, h, profile, Nets::default())
     }
 
     /// [`G2Surface::new`] over control nets made by the rule `nets` instead of the default.
     ///
     /// # Panics
-    /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
+    /// If `h`, `topo` and `mesh` do not belong together (a caller bug).
     pub fn with_nets(
         mesh: &TriMesh,
         topo: &Topology,
-        h_per_edge: &[f64],
+        h: &EffectiveH,
         profile: Profile,
         nets_rule: Nets,
     ) -> Self {
-        super::assert_belong_together(mesh, topo, h_per_edge);
+        super::assert_belong_together(mesh, topo, h);
 
-        // The one rule for which edges blend and how wide (widths the pipeline resolved pass
-        // through it unchanged, and without warnings).
-        let (h_edge, warnings) = EffectiveH::from_requested(topo, h_per_edge);
         let vertices: Vec<CornerVertex> = mesh
             .positions
             .par_iter()
@@ -126,88 +204,69 @@ impl G2Surface {
                 normal: normal.normalize_or(DVec3::ZERO),
             })
             .collect();
-        // Built in place, in the final array: no per-triangle corner or net arrays beside it.
+        // Built in place, in the final array, in one pass: no per-triangle corner or net arrays
+        // beside it.
         let mut patches: Vec<Patch> = (0..mesh.triangles.len())
             .into_par_iter()
             .map(|t| {
                 let verts = mesh.triangles[t];
                 let (position, normal) = corners(&vertices, verts);
-                let edges = topo.tri_edges[t].map(|e| e.0);
+                let widths = topo.tri_edges[t].map(|e| h[e.0 as usize]);
                 let across = std::array::from_fn(|k| {
-                    if h_edge[edges[k] as usize] > 0.0 {
+                    if widths[k] > 0.0 {
                         let n = topo
                             .neighbour(TriId(t as u32), k)
                             .expect("blended edges are interior");
-                        Across {
-                            tri: n.tri.0,
-                            slots: n.slots,
-                        }
+                        Across::pack(n)
                     } else {
-                        Across::default()
+                        0
                     }
                 });
-                let net = soa(&nets_rule.net(position, normal));
                 Patch {
-                    inner: net.map(|c| std::array::from_fn(|m| c[3 + m])),
+                    inner: offsets(&nets_rule.net(position, normal)),
                     verts,
                     across,
-                    edges,
+                    widths,
+                    as_stored: 0,
                 }
             })
             .collect();
-        share_unblended_edge_curves(topo, &h_edge, &vertices, &mut patches, nets_rule);
+        share_unblended_edge_curves(topo, h, &vertices, &mut patches, nets_rule);
 
         G2Surface {
             patches,
             vertices,
             profile,
-            h_edge,
-            warnings,
             patterns: PatternCache::default(),
         }
     }
 
-    /// The width each edge is actually blended with (0 for edges that are not).
-    pub fn effective_h(&self) -> &[f64] {
-        &self.h_edge
+    /// Bytes this surface holds on the heap for its triangles and vertices (capacities, not
+    /// lengths; the pattern cache, shared by all triangles, is not counted).
+    pub fn heap_bytes(&self) -> usize {
+        self.patches.capacity() * std::mem::size_of::<Patch>()
+            + self.vertices.capacity() * std::mem::size_of::<CornerVertex>()
     }
 
     /// The neighbour's net across edge `k` of `patch` in `patch`'s barycentrics, `b_g ∘ M`
     /// (Eq. 3 in the form of [`neighbour_map`]); `k` must be a blended edge.
     fn across_net(&self, patch: &Patch, k: usize) -> SoaNet {
-        debug_assert!(
-            self.h_edge[patch.edges[k] as usize] > 0.0,
-            "only blended edges"
-        );
-        let across = patch.across[k];
-        let g = aos(&self.local(across.tri as usize).net);
-        soa(&compose(
-            &g,
-            neighbour_map(k, across.slots.map(usize::from)),
-        ))
+        debug_assert!(patch.widths[k] > 0.0, "only blended edges");
+        let (tri, slots) = Across::unpack(patch.across[k]);
+        let g = aos(&self.local(tri).net);
+        soa(&compose(&g, neighbour_map(k, slots)))
     }
 
     /// Triangle `tri`'s whole net and corner normals, exactly as they were when its net was
-    /// made.
+    /// stored.
     #[inline]
     fn local(&self, tri: usize) -> Local {
         local(&self.vertices, &self.patches[tri])
     }
 
-    /// The effective widths of `patch`'s edges, opposite corners 0, 1, 2.
-    #[inline]
-    fn widths(&self, patch: &Patch) -> [f64; 3] {
-        patch.edges.map(|e| self.h_edge[e as usize])
-    }
-
     /// The profile `r(s)` in use.
     pub fn profile(&self) -> Profile {
         self.profile
-    }
-
-    /// Edges asked to blend that cannot (boundary, non-manifold, degenerate).
-    pub fn warnings(&self) -> &[Warning] {
-        &self.warnings
     }
 
     /// The surface points of `L` domain points of `patch` from their weights, on its own net
@@ -316,17 +375,17 @@ fn corner(net: &SoaNet, c: usize) -> DVec3 {
 fn corners(vertices: &[CornerVertex], verts: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
     let v = verts.map(|v| vertices[v as usize]);
     let position = v.map(|v| v.position);
-    let face = face_fallback(position);
-    (
-        position,
-        v.map(|v| {
-            if v.normal == DVec3::ZERO {
-                face
-            } else {
-                v.normal
-            }
-        }),
-    )
+    // Only for the rare vertex without a normal: every patch set-up and every lattice part
+    // comes through here.
+    let mut face = None;
+    let normal = v.map(|v| {
+        if v.normal == DVec3::ZERO {
+            *face.get_or_insert_with(|| face_fallback(position))
+        } else {
+            v.normal
+        }
+    });
+    (position, normal)
 }
 
 /// The unit face normal of a triangle (+z if it has none): the corner normal of an input
@@ -340,15 +399,54 @@ fn face_fallback(p: [DVec3; 3]) -> DVec3 {
 #[inline]
 fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
     let (position, normal) = corners(vertices, patch.verts);
-    let net = std::array::from_fn(|x| {
+    let mut net = std::array::from_fn(|x| {
+        let p = coordinate(&position, x);
         let mut coord = [0.0; 10];
-        for c in 0..3 {
-            coord[c] = position[c][x];
+        coord[..3].copy_from_slice(&p);
+        for (m, (point, &offset)) in coord[3..].iter_mut().zip(&patch.inner[x]).enumerate() {
+            *point = flat_point(p, 3 + m) + f64::from(offset);
         }
-        coord[3..].copy_from_slice(&patch.inner[x]);
         coord
     });
+    onto_tangent_planes(&mut net, &normal, patch.as_stored);
     Local { net, normal }
+}
+
+/// Edge control point `slot` of `patch`, as [`local`] rebuilds it.
+fn edge_point(vertices: &[CornerVertex], patch: &Patch, slot: usize) -> DVec3 {
+    let net = local(vertices, patch).net;
+    DVec3::new(net[0][slot], net[1][slot], net[2][slot])
+}
+
+/// Moves the edge points of `net` that lie in their corner's tangent plane (all but those in
+/// `as_stored`) back into it: `b ← b − ((b − p_c)·n_c) n_c`. Both triangles of an edge do the
+/// same arithmetic on the same corner and offsets, so shared curves stay shared bit for bit.
+#[inline]
+fn onto_tangent_planes(net: &mut SoaNet, normal: &[DVec3; 3], as_stored: u8) {
+    for (m, &[c, _]) in NEAR_OF.iter().enumerate() {
+        if as_stored & (1 << m) != 0 {
+            continue;
+        }
+        let slot = m + 3;
+        let v = DVec3::new(
+            net[0][slot] - net[0][c],
+            net[1][slot] - net[1][c],
+            net[2][slot] - net[2][c],
+        );
+        let d = v.dot(normal[c]);
+        for (x, coord) in net.iter_mut().enumerate() {
+            coord[slot] = coord[c] + (v[x] - d * normal[c][x]);
+        }
+    }
+}
+
+/// Stores `value` as control point `slot` (3 to 9) of `patch`.
+fn set_point(vertices: &[CornerVertex], patch: &mut Patch, slot: usize, value: DVec3) {
+    let position = patch.verts.map(|v| vertices[v as usize].position);
+    for x in 0..3 {
+        let flat = flat_point(coordinate(&position, x), slot);
+        patch.inner[x][slot - 3] = (value[x] - flat) as f32;
+    }
 }
 
 /// One patch set up for single points: its net broadcast once, and each neighbour's net
@@ -368,7 +466,7 @@ impl<'a> PointEvaluation<'a> {
         let local = surface.local(tri);
         PointEvaluation {
             patch,
-            widths: surface.widths(patch),
+            widths: patch.widths,
             own: broadcast(&local.net),
             local,
             across: [None; 3],
@@ -417,7 +515,7 @@ impl Surface for G2Surface {
         let patch = &self.patches[tri];
         let local = self.local(tri);
         self.patterns
-            .with(level, part, self.widths(patch), self.profile, |pattern| {
+            .with(level, part, patch.widths, self.profile, |pattern| {
                 let base = out.len();
                 out.resize(
                     base + pattern.len,
@@ -468,11 +566,10 @@ impl PnSurface {
     /// PN triangles over `mesh` on nets made by the rule `nets` ([`Nets::Paper`]: Vlachos et
     /// al. as published).
     pub fn with_nets(mesh: &TriMesh, topo: &Topology, nets: Nets) -> Self {
-        let zero = vec![0.0; topo.edge_count()];
         PnSurface(G2Surface::with_nets(
             mesh,
             topo,
-            &zero,
+            &EffectiveH::zero(topo),
             Profile::default(),
             nets,
         ))
@@ -515,10 +612,7 @@ fn share_unblended_edge_curves(
     rule: Nets,
 ) {
     // Edge points only: never a corner.
-    let point = |t: usize, s: usize| {
-        let inner = &patches[t].inner;
-        DVec3::new(inner[0][s - 3], inner[1][s - 3], inner[2][s - 3])
-    };
+    let point = |t: usize, s: usize| edge_point(vertices, &patches[t], s);
     let uses = |edge| edge_uses(topo, edge);
     let averaged: Vec<(usize, [DVec3; 2])> = topo
         .par_edges()
@@ -549,8 +643,8 @@ fn share_unblended_edge_curves(
     for (e, avg) in averaged {
         for (t, s) in uses(topo.edge(EdgeId(e as u32))) {
             for (slot, value) in s.into_iter().zip(avg) {
-                let inner = &mut patches[t].inner;
-                [inner[0][slot - 3], inner[1][slot - 3], inner[2][slot - 3]] = value.to_array();
+                set_point(vertices, &mut patches[t], slot, value);
+                patches[t].as_stored |= 1 << (slot - 3);
             }
             touched.push(t as u32);
         }
@@ -561,8 +655,7 @@ fn share_unblended_edge_curves(
         let patch = &mut patches[t as usize];
         let Local { net, normal } = local(vertices, patch);
         let centre = rule.centre(&aos(&net), normal);
-        let b = B111 - 3;
-        [patch.inner[0][b], patch.inner[1][b], patch.inner[2][b]] = centre.to_array();
+        set_point(vertices, patch, B111, centre);
     }
 }
 

@@ -43,7 +43,7 @@ fn low_poly(mesh: &TriMesh) -> Scene {
 fn bench(c: &mut Criterion) {
     let mesh = (0..4).fold(support::icosahedron(), |m, _| support::subdivide(&m));
     let topo = Topology::build(&mesh);
-    let h = vec![0.212; topo.edge_count()];
+    let h = support::h_all(&topo, 0.212);
     let surface = G2Surface::new(&mesh, &topo, &h, Profile::C2);
     let whole = 0..mesh.triangles.len();
     let dense = tessellate(

@@ -22,7 +22,7 @@ const LEVEL: u32 = 16;
 fn bench(c: &mut Criterion) {
     let mesh = support::bumpy_sphere();
     let topo = Topology::build(&mesh);
-    let h = vec![0.212; topo.edge_count()];
+    let h = support::h_all(&topo, 0.212);
     let d = SchemeParams::default();
     let fo = SchemeParams {
         constituents: Constituents::FoleyOpitz,

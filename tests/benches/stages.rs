@@ -32,7 +32,7 @@ fn sphere(times: usize) -> TriMesh {
 fn bench(c: &mut Criterion) {
     let mesh = sphere(3);
     let topo = Topology::build(&mesh);
-    let h = vec![0.212; topo.edge_count()];
+    let h = support::h_all(&topo, 0.212);
     let surface = G2Surface::new(&mesh, &topo, &h, Profile::C2);
     let out_tris = (mesh.triangles.len() as u64) * u64::from(LEVEL * LEVEL);
     let whole = 0..mesh.triangles.len();

@@ -6,6 +6,7 @@ use crate::schemes_support::*;
 use crate::support::*;
 use g2tess::continuity::{self, angle_deg, Sampling};
 use g2tess::mesh::TriMesh;
+use g2tess::sharpness::EffectiveH;
 use g2tess::surface::coons::Constituents;
 use g2tess::surface::hybrid::HybridSurface;
 use g2tess::surface::scheme::Warning;
@@ -97,7 +98,7 @@ fn mixed_h_gives_g1_on_smooth_edges_and_creases_elsewhere() {
         .collect();
     let l = continuity::mean_edge_length(&topo);
     for (name, scheme, params) in schemes() {
-        let (s, _) = build_surface(scheme, &mesh, &topo, &h, &params);
+        let (s, _) = build_surface(scheme, &mesh, &topo, &widths(&topo, &h), &params);
         let jumps = edge_jumps(s.as_ref(), &topo, 11, 0.02);
         let mut crease_max: f64 = 0.0;
         for (e, gap, angle) in jumps {
@@ -115,34 +116,25 @@ fn mixed_h_gives_g1_on_smooth_edges_and_creases_elsewhere() {
     }
 }
 
-fn boundary_warning(w: &[Warning]) -> Option<usize> {
-    w.iter().find_map(|w| match w {
-        Warning::Edges(topology::Warning::BlendIgnored {
-            kind: EdgeKind::Boundary,
-            edges,
-            ..
-        }) => Some(*edges),
-        _ => None,
-    })
-}
-
 #[test]
-fn boundary_edges_asked_to_blend_are_reported_in_every_scheme() {
+fn boundary_edges_asked_to_blend_are_reported_once_by_the_rule_and_not_again_by_any_scheme() {
     let mesh = height_field(6);
     let topo = Topology::build(&mesh);
     let boundary = topo
         .edges()
         .filter(|e| e.kind == EdgeKind::Boundary)
         .count();
+    let (h, ignored) = EffectiveH::from_requested(&topo, &vec![0.2; topo.edge_count()]);
+    assert!(
+        matches!(
+            ignored[..],
+            [topology::Warning::BlendIgnored { kind: EdgeKind::Boundary, edges, .. }] if edges == boundary
+        ),
+        "{ignored:?}"
+    );
     for scheme in [Scheme::G2, Scheme::Hybrid, Scheme::Coons] {
-        let (_, w) = build_surface(
-            scheme,
-            &mesh,
-            &topo,
-            &h_all(&topo, 0.2),
-            &SchemeParams::default(),
-        );
-        assert_eq!(boundary_warning(&w), Some(boundary), "{scheme}: {w:?}");
+        let (_, w) = build_surface(scheme, &mesh, &topo, &h, &SchemeParams::default());
+        assert!(w.is_empty(), "{scheme}: {w:?}");
     }
 }
 
@@ -177,19 +169,21 @@ fn a_folded_edge_with_no_projection_plane_becomes_a_reported_crease() {
 fn non_manifold_edges_are_reported_and_every_triangle_shares_the_edge_curve() {
     let mesh = non_manifold_fan();
     let topo = Topology::build(&mesh);
+    let (h, ignored) = EffectiveH::from_requested(&topo, &vec![0.2; topo.edge_count()]);
+    assert!(
+        ignored.iter().any(|w| matches!(
+            w,
+            topology::Warning::BlendIgnored {
+                kind: EdgeKind::NonManifold,
+                edges: 1,
+                ..
+            }
+        )),
+        "{ignored:?}"
+    );
     for (name, scheme, params) in schemes() {
-        let (s, w) = build_surface(scheme, &mesh, &topo, &h_all(&topo, 0.2), &params);
-        assert!(
-            w.iter().any(|w| matches!(
-                w,
-                Warning::Edges(topology::Warning::BlendIgnored {
-                    kind: EdgeKind::NonManifold,
-                    edges: 1,
-                    ..
-                })
-            )),
-            "{name}: {w:?}"
-        );
+        let (s, w) = build_surface(scheme, &mesh, &topo, &h, &params);
+        assert!(w.is_empty(), "{name}: {w:?}");
         // Triangle t = [0, 1, apex]: the shared edge is opposite corner 2.
         for x in [0.1, 0.5, 0.9] {
             let p: Vec<DVec3> = (0..3)

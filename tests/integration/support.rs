@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 
 use g2tess::mesh::TriMesh;
+use g2tess::sharpness::EffectiveH;
 use g2tess::topology::Topology;
 use glam::DVec3;
 
@@ -283,9 +284,15 @@ pub fn reorder(mesh: &TriMesh, reversed: f64, seed: u64) -> Reordered {
     Reordered { mesh: out, perm }
 }
 
-/// The same `h` on every edge.
-pub fn h_all(topo: &Topology, h: f64) -> Vec<f64> {
-    vec![h; topo.edge_count()]
+/// The same `h` asked for on every edge, as the surfaces take it: 0 on the edges that cannot
+/// blend (the rule of [`EffectiveH::from_requested`]).
+pub fn h_all(topo: &Topology, h: f64) -> EffectiveH {
+    widths(topo, &vec![h; topo.edge_count()])
+}
+
+/// Requested widths `h` (one per edge of `topo`) as the surfaces take them.
+pub fn widths(topo: &Topology, h: &[f64]) -> EffectiveH {
+    EffectiveH::from_requested(topo, h).0
 }
 
 /// Mean edge length of a mesh.

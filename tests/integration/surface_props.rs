@@ -3,7 +3,7 @@
 //! vertex normal reached at the centre of a fan. Regressions are kept in
 //! `tests/surface_props.proptest-regressions`.
 
-use crate::support::vertex_normals;
+use crate::support::{h_all, vertex_normals};
 use g2tess::continuity::{self, angle_deg, Sampling};
 use g2tess::mesh::TriMesh;
 use g2tess::surface::{G2Surface, Profile, Surface, H_MAX};
@@ -47,7 +47,7 @@ fn reorder(mesh: &mut TriMesh, rot: &[usize], flip: &[bool]) {
 /// interior edge, and corners exact.
 fn check(mesh: &TriMesh, h: f64, profile: Profile) -> Result<(), TestCaseError> {
     let topo = Topology::build(mesh);
-    let s = G2Surface::new(mesh, &topo, &vec![h; topo.edge_count()], profile);
+    let s = G2Surface::new(mesh, &topo, &h_all(&topo, h), profile);
     // The blend reaches r ≤ h from the edge: eps must be well inside that to see G2.
     let sampling = Sampling {
         eps: vec![h * 1e-2, h * 1e-3, h * 1e-4],
@@ -135,7 +135,7 @@ proptest! {
         // per unit near its corner, and that is still G1. 1e-6° is the rounding floor of the
         // normal at unit scale.
         let topo = Topology::build(&mesh);
-        let s = G2Surface::new(&mesh, &topo, &vec![h; topo.edge_count()], profile);
+        let s = G2Surface::new(&mesh, &topo, &h_all(&topo, h), profile);
         let angle_at = |t: usize, c: usize, d: f64| {
             let mut l = [d / 2.0; 3];
             l[c] = 1.0 - d;

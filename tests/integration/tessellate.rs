@@ -6,12 +6,13 @@
 
 use crate::support::*;
 use g2tess::mesh::TriMesh;
+use g2tess::sharpness::EffectiveH;
 use g2tess::surface::{G2Surface, Profile, Surface};
 use g2tess::tessellate::{tessellate, DenseMesh, VertexSource};
 use g2tess::topology::Topology;
 use glam::DVec3;
 
-fn run(mesh: &TriMesh, h: f64, level: u32) -> (Topology, Vec<f64>, DenseMesh) {
+fn run(mesh: &TriMesh, h: f64, level: u32) -> (Topology, EffectiveH, DenseMesh) {
     let topo = Topology::build(mesh);
     let hs = h_all(&topo, h);
     let surface = G2Surface::new(mesh, &topo, &hs, Profile::C2);

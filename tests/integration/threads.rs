@@ -26,8 +26,9 @@ fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
 fn dense(threads: usize) -> Vec<DenseMesh> {
     let mesh = split_normals(&torus(12), 0.2);
     let topo = Topology::build(&mesh);
-    let mut h = h_all(&topo, 0.2);
-    h.iter_mut().step_by(5).for_each(|x| *x = 0.0);
+    let mut asked = vec![0.2; topo.edge_count()];
+    asked.iter_mut().step_by(5).for_each(|x| *x = 0.0);
+    let h = widths(&topo, &asked);
     let surface = G2Surface::new(&mesh, &topo, &h, Profile::C2);
     let half = mesh.triangles.len() / 3;
     in_pool(threads, || {

@@ -65,6 +65,7 @@ use super::scheme::creases::{own_nets, smooth_edges, Corners};
 use super::scheme::{SchemeParams, Warning};
 use super::{blend, lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
+use crate::sharpness::EffectiveH;
 use crate::topology::{Topology, TriId};
 use patch::Definition2;
 use weights::Weights;
@@ -137,7 +138,12 @@ impl CoonsSurface {
     ///
     /// # Panics
     /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
-    pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64], params: &SchemeParams) -> Self {
+    pub fn new(
+        mesh: &TriMesh,
+        topo: &Topology,
+        h_per_edge: &EffectiveH,
+        params: &SchemeParams,
+    ) -> Self {
         super::assert_belong_together(mesh, topo, h_per_edge);
         let (corners, nets, smooth, warnings) = match params.constituents {
             Constituents::PnAverage => pn_average(mesh, topo, h_per_edge),
@@ -331,11 +337,12 @@ fn permute_net(net: &Net, perm: [usize; 3]) -> Net {
 type Built = (Vec<Corners>, Vec<[Net; 3]>, Vec<bool>, Vec<Warning>);
 
 /// Constituents `½(PN_f + PN_g ∘ M)` on smooth edges, the own PN net elsewhere.
-fn pn_average(mesh: &TriMesh, topo: &Topology, h: &[f64]) -> Built {
+fn pn_average(mesh: &TriMesh, topo: &Topology, h: &EffectiveH) -> Built {
     let corners: Vec<Corners> = (0..mesh.triangles.len())
         .map(|t| Corners::of(mesh, t))
         .collect();
-    let (smooth, warnings) = smooth_edges(topo, h);
+    let smooth = smooth_edges(h);
+    let warnings = Vec::new();
     let own = own_nets(&corners, topo, &smooth);
     let nets = (0..own.len())
         .map(|t| {

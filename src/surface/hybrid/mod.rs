@@ -48,6 +48,7 @@ use super::scheme::creases::{edge_end_normal, own_nets, smooth_edges, Corners};
 use super::scheme::Warning;
 use super::{lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
+use crate::sharpness::EffectiveH;
 use crate::topology::{EdgeId, Topology, TriId};
 use foley_opitz::{apex_barycentrics, interior_point, neighbour_interior, Labelled};
 use patch::{BoundaryBlend, Weights, TERMS};
@@ -82,12 +83,18 @@ impl EdgeNets {
     ///
     /// # Panics
     /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
-    pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64], reading: PaperReading) -> Self {
+    pub fn new(
+        mesh: &TriMesh,
+        topo: &Topology,
+        h_per_edge: &EffectiveH,
+        reading: PaperReading,
+    ) -> Self {
         super::assert_belong_together(mesh, topo, h_per_edge);
         let corners: Vec<Corners> = (0..mesh.triangles.len())
             .map(|t| Corners::of(mesh, t))
             .collect();
-        let (mut smooth, mut warnings) = smooth_edges(topo, h_per_edge);
+        let mut smooth = smooth_edges(h_per_edge);
+        let mut warnings = Vec::new();
 
         let mut planes = vec![DVec3::ZERO; topo.edge_count()];
         let mut failed: Option<(usize, usize)> = None;
@@ -279,7 +286,7 @@ impl HybridSurface {
     ///
     /// # Panics
     /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
-    pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64]) -> Self {
+    pub fn new(mesh: &TriMesh, topo: &Topology, h_per_edge: &EffectiveH) -> Self {
         Self::with_reading(mesh, topo, h_per_edge, PaperReading::Corrected)
     }
 
@@ -287,7 +294,7 @@ impl HybridSurface {
     pub fn with_reading(
         mesh: &TriMesh,
         topo: &Topology,
-        h_per_edge: &[f64],
+        h_per_edge: &EffectiveH,
         reading: PaperReading,
     ) -> Self {
         let blend = match reading {

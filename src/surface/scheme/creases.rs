@@ -6,7 +6,6 @@
 
 use glam::DVec3;
 
-use super::Warning;
 use crate::mesh::TriMesh;
 use crate::sharpness::EffectiveH;
 use crate::surface::pn::{central_point, pn_net, Net, B111, NEAR};
@@ -63,16 +62,10 @@ impl Corners {
     }
 }
 
-/// Which edges are smooth: those the one rule ([`EffectiveH::from_requested`]) gives a width
-/// above 0, that is interior edges with `h > 0` (NaN counts as 0). Non-interior edges asked for
-/// `h > 0` are creases, reported once per kind as in the G² scheme.
-///
-/// # Panics
-/// If `h` does not have one entry per edge of `topo`.
-pub fn smooth_edges(topo: &Topology, h: &[f64]) -> (Vec<bool>, Vec<Warning>) {
-    let (effective, ignored) = EffectiveH::from_requested(topo, h);
-    let smooth = effective.iter().map(|&h| h > 0.0).collect();
-    (smooth, ignored.into_iter().map(Warning::Edges).collect())
+/// Which edges are smooth: those the one rule ([`EffectiveH`]) gave a width above 0, that is
+/// interior edges asked for `h > 0`; every other edge is a crease.
+pub fn smooth_edges(h: &EffectiveH) -> Vec<bool> {
+    h.iter().map(|&h| h > 0.0).collect()
 }
 
 /// Each triangle's PN net (seed 000 Eq. 2, all six edge points in `E`), with one boundary curve

@@ -23,6 +23,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::mesh::TriMesh;
+use crate::sharpness::EffectiveH;
 use crate::topology::{self, EdgeId, Topology};
 
 use super::coons::{Constituents, CoonsSurface};
@@ -154,7 +155,8 @@ impl fmt::Display for Warning {
 }
 
 /// Builds `scheme` over `mesh`, one `h` per welded edge of `topo` (indexed by
-/// [`EdgeId`]), and returns it with the fallbacks it took.
+/// [`EdgeId`]) as the one rule of [`EffectiveH`] decided it, and returns it with the fallbacks
+/// it took.
 ///
 /// # Panics
 /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
@@ -162,15 +164,20 @@ pub fn build_surface(
     scheme: Scheme,
     mesh: &TriMesh,
     topo: &Topology,
-    h_per_edge: &[f64],
+    h_per_edge: &EffectiveH,
     params: &SchemeParams,
 ) -> (Box<dyn Surface>, Vec<Warning>) {
     match scheme {
-        Scheme::G2 => {
-            let s = G2Surface::with_nets(mesh, topo, h_per_edge, params.profile, params.nets);
-            let w = s.warnings().iter().cloned().map(Warning::Edges).collect();
-            (Box::new(s), w)
-        }
+        Scheme::G2 => (
+            Box::new(G2Surface::with_nets(
+                mesh,
+                topo,
+                h_per_edge,
+                params.profile,
+                params.nets,
+            )),
+            Vec::new(),
+        ),
         Scheme::Pn => (
             Box::new(PnSurface::with_nets(mesh, topo, params.nets)),
             Vec::new(),
