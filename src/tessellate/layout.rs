@@ -101,11 +101,9 @@ impl GroupLayout {
                     .map(|k2| per_edge(first + offset, k2))
                     .sum::<u32>()
         };
-        let counts: Vec<u32> = (0..triangles.len())
-            .into_par_iter()
-            .map(|offset| edge_start(offset, 3) + interior(first + offset))
-            .collect();
-        let base = exclusive_prefix_sum(&counts);
+        let base = exclusive_prefix_sum(triangles.len(), |offset| {
+            edge_start(offset, 3) + interior(first + offset)
+        });
         let mut corner_slot = vec![0u32; 3 * triangles.len()];
         let mut edge_slot = vec![0u32; 3 * triangles.len()];
         corner_slot
@@ -154,27 +152,32 @@ fn first_use_of_each_vertex(triangles: &[[u32; 3]], vertices: usize) -> Vec<Atom
     first
 }
 
-/// `counts` summed before each entry, and the total as one more entry: per-chunk sums in
-/// parallel, a serial pass over the chunks' totals, then each chunk filled in parallel.
-fn exclusive_prefix_sum(counts: &[u32]) -> Vec<u32> {
+/// `count(i)` for `i` in `0..len` summed before each `i`, and the total as one more entry:
+/// per-chunk sums in parallel, a serial pass over the chunks' totals, then each chunk filled in
+/// parallel. The counts are computed twice rather than stored: one array less to fault in.
+fn exclusive_prefix_sum(len: usize, count: impl Fn(usize) -> u32 + Sync) -> Vec<u32> {
     const CHUNK: usize = 1 << 14;
-    let totals: Vec<u32> = counts.par_chunks(CHUNK).map(|c| c.iter().sum()).collect();
+    let chunk = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(len);
+    let totals: Vec<u32> = (0..len.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| chunk(c).map(&count).sum())
+        .collect();
     let mut starts = Vec::with_capacity(totals.len());
     let mut sum = 0u32;
     for t in &totals {
         starts.push(sum);
         sum += t;
     }
-    let mut out = vec![0u32; counts.len() + 1];
-    out[counts.len()] = sum;
-    out[..counts.len()]
+    let mut out = vec![0u32; len + 1];
+    out[len] = sum;
+    out[..len]
         .par_chunks_mut(CHUNK)
-        .zip(counts.par_chunks(CHUNK))
         .zip(starts)
-        .for_each(|((out, counts), mut at)| {
-            for (o, &c) in out.iter_mut().zip(counts) {
+        .enumerate()
+        .for_each(|(c, (out, mut at))| {
+            for (o, i) in out.iter_mut().zip(chunk(c)) {
                 *o = at;
-                at += c;
+                at += count(i);
             }
         });
     out
