@@ -28,9 +28,11 @@
 //! of a group is index arithmetic on the input triangles (`layout.rs`), so every block of
 //! consecutive source triangles owns a contiguous range of the final vertex and index buffers.
 //! Each output vertex is evaluated once: a corner is the input vertex (no evaluation), the
-//! samples of a welded edge come from one shared pass, positions and normals (a triangle that
-//! owns a split copy of them evaluates only its own normals there), and each triangle evaluates
-//! only its interior ([`LatticePart`]). That per-triangle loop is one piece of code
+//! samples of a welded edge are evaluated by the triangle that writes them, straight into the
+//! output (no array of edge samples in between; a triangle that owns a split copy of them
+//! evaluates the edge's evaluating side once more for the positions and its own side for the
+//! normals), and each triangle evaluates only its interior
+//! ([`LatticePart`](crate::surface::LatticePart)). That per-triangle loop is one piece of code
 //! (`emit.rs`) for this uniform path and the per-edge-count path (`adaptive.rs`).
 //! Blocks run in parallel (rayon) and write straight into those ranges: no per-vertex
 //! allocation, no hash map, and the same bytes at any thread count. Triangles come out in
@@ -49,7 +51,7 @@ mod plan;
 mod transition;
 
 use crate::mesh::TriMesh;
-use crate::surface::{lattice_bary, LatticePart, Surface, SurfacePoint};
+use crate::surface::{lattice_bary, Surface};
 use crate::topology::{EdgeId, Topology};
 use blocks::Block;
 use layout::GroupLayout;
@@ -174,20 +176,10 @@ pub fn tessellate(
         "level {level} is above {MAX_TESSELLATION_LEVEL}"
     );
     let plan = LatticePlan::new(level.max(1));
-    let edge_samples = shared_edge_samples(mesh, topo, surface, plan.n);
     groups
         .par_iter()
-        .map(|range| tessellate_group(mesh, topo, h, surface, &plan, range.clone(), &edge_samples))
+        .map(|range| tessellate_group(mesh, topo, h, surface, &plan, range.clone()))
         .collect()
-}
-
-/// The samples of every welded edge, `n - 1` per edge in the edge's canonical direction
-/// (`verts[0]` to `verts[1]`), as written to the output.
-struct EdgeSamples {
-    positions: Vec<[f32; 3]>,
-    /// The normals of the evaluating triangle ([`evaluator`]); other triangles that own a copy
-    /// of the samples evaluate their own, which differ across a crease.
-    normals: Vec<[f32; 3]>,
 }
 
 /// The triangle that evaluates the samples of welded edge `e` for everyone, and the corner its
@@ -197,44 +189,6 @@ struct EdgeSamples {
 /// side, so a search made a book of many triangles on one edge quadratic.
 fn evaluator(topo: &Topology, e: usize) -> Option<(usize, usize)> {
     Some(topo.edge_uses(EdgeId(e as u32)).first()?.at())
-}
-
-/// Evaluates the samples of every welded edge once, from its [`evaluator`].
-fn shared_edge_samples(
-    mesh: &TriMesh,
-    topo: &Topology,
-    surface: &dyn Surface,
-    n: u32,
-) -> EdgeSamples {
-    let per_edge = (n - 1) as usize;
-    let mut out = EdgeSamples {
-        positions: vec![[0.0f32; 3]; topo.edge_count() * per_edge],
-        normals: vec![[0.0f32; 3]; topo.edge_count() * per_edge],
-    };
-    if per_edge == 0 || mesh.triangles.is_empty() {
-        return out;
-    }
-    out.positions
-        .par_chunks_mut(per_edge)
-        .zip(out.normals.par_chunks_mut(per_edge))
-        .enumerate()
-        .for_each_init(
-            || Vec::with_capacity(per_edge),
-            |values: &mut Vec<SurfacePoint>, (e, (positions, normals))| {
-                let Some((tri, k)) = evaluator(topo, e) else {
-                    return;
-                };
-                values.clear();
-                surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), values);
-                let forward = canonical_forward(topo, tri, k);
-                for (m, p) in (1..n).zip(values.iter()) {
-                    let slot = (if forward { m } else { n - m } - 1) as usize;
-                    positions[slot] = p.position.as_vec3().to_array();
-                    normals[slot] = p.normal.as_vec3().to_array();
-                }
-            },
-        );
-    out
 }
 
 /// Whether the edge opposite corner `k` of `tri`, walked from corner `k+1` to corner `k+2`,
@@ -280,7 +234,6 @@ struct Shared<'a> {
     surface: &'a dyn Surface,
     plan: &'a LatticePlan,
     layout: &'a GroupLayout,
-    edge_samples: &'a EdgeSamples,
     first_tri: usize,
 }
 
@@ -291,7 +244,6 @@ fn tessellate_group(
     surface: &dyn Surface,
     plan: &LatticePlan,
     range: Range<usize>,
-    edge_samples: &EdgeSamples,
 ) -> DenseMesh {
     let n = plan.n;
     let layout = GroupLayout::new(mesh, topo, h, n, plan.interior, range.clone());
@@ -327,7 +279,6 @@ fn tessellate_group(
         surface,
         plan,
         layout: &layout,
-        edge_samples,
         first_tri: range.start,
     };
     blocks
@@ -347,19 +298,11 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
         surface,
         plan,
         layout,
-        edge_samples,
         first_tri,
     } = *shared;
     let n = plan.n;
-    let per_edge = (n - 1) as usize;
     let per_tri_indices = 3 * (n * n) as usize;
-    let mut writer = emit::TriangleWriter::new(
-        mesh,
-        topo,
-        surface,
-        &edge_samples.positions,
-        &edge_samples.normals,
-    );
+    let mut writer = emit::TriangleWriter::in_place(mesh, topo, surface);
     let mut local = vec![0u32; plan.len];
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
@@ -399,7 +342,7 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
                 layout.edge_slot[3 * offset + k] as usize,
                 corners[(k + 1) % 3] <= corners[(k + 2) % 3],
                 owns & (8 << k) != 0,
-                |e| e * per_edge,
+                |_| 0,
                 |m| lis[(m - 1) as usize] as usize,
                 source,
             );
