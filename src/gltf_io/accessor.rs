@@ -3,7 +3,13 @@
 //! accessors.
 //!
 //! Every declared count and offset is checked against the bytes present before anything is
-//! allocated. It deliberately does not interpret semantics (that is [`super::primitive`]'s job).
+//! allocated. An accessor whose elements lie tightly packed in its buffer view (the common case:
+//! no stride, no matrix padding, no sparse substitution) is read in place, borrowing the
+//! buffer's bytes: decoding a large primitive then copies each array once, from the file's
+//! bytes into the final typed array. It deliberately does not interpret semantics (that is
+//! [`super::primitive`]'s job).
+
+use std::borrow::Cow;
 
 use gltf_json::accessor::{ComponentType, Type};
 use gltf_json::validation::Checked;
@@ -11,9 +17,10 @@ use gltf_json::validation::Checked;
 use super::document::Document;
 use super::error::{Error, Result};
 
-/// An accessor's elements, tightly packed (no stride, no matrix padding), little-endian.
+/// An accessor's elements, tightly packed (no stride, no matrix padding), little-endian:
+/// borrowed from the document where they already lie that way, else decoded into a copy.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Accessor {
+pub struct Accessor<'a> {
     /// The stored component type.
     pub component_type: ComponentType,
     /// Components per element (1 for SCALAR … 16 for MAT4).
@@ -22,7 +29,7 @@ pub struct Accessor {
     pub normalized: bool,
     /// Number of elements.
     pub count: usize,
-    bytes: Vec<u8>,
+    bytes: Cow<'a, [u8]>,
 }
 
 /// Bytes per component.
@@ -81,8 +88,9 @@ pub fn decoded_size(a: &gltf_json::Accessor) -> u64 {
     }
 }
 
-/// Reads accessor `index` of `doc`, applying sparse substitution.
-pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
+/// Reads accessor `index` of `doc`, applying sparse substitution; borrows the document's bytes
+/// where they are already tightly packed.
+pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor<'_>> {
     let at = format!("accessors[{index}]");
     let a = doc
         .root
@@ -109,7 +117,7 @@ pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
             )
         })?;
     let count = count as usize;
-    let mut bytes = Vec::new();
+    let mut bytes: Cow<'_, [u8]> = Cow::Borrowed(&[]);
     match a.buffer_view {
         Some(view) => {
             let v = &doc.root.buffer_views[view.value()];
@@ -129,16 +137,24 @@ pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
                     ));
                 }
             }
-            bytes.reserve_exact(total as usize);
-            for i in 0..count {
-                let e = offset + i * stride;
-                for c in 0..cols {
-                    let s = e + c * col_bytes;
-                    bytes.extend_from_slice(&data[s..s + rows * csize]);
+            if count == 0 {
+                // Nothing to read (and the offset need not lie inside the view).
+            } else if stride == elem_packed && elem_stored == elem_packed {
+                // Already tightly packed: read in place (a sparse accessor copies below).
+                bytes = Cow::Borrowed(&data[offset..offset + total as usize]);
+            } else {
+                let mut packed = Vec::with_capacity(total as usize);
+                for i in 0..count {
+                    let e = offset + i * stride;
+                    for c in 0..cols {
+                        let s = e + c * col_bytes;
+                        packed.extend_from_slice(&data[s..s + rows * csize]);
+                    }
                 }
+                bytes = Cow::Owned(packed);
             }
         }
-        None => bytes.resize(total as usize, 0),
+        None => bytes = Cow::Owned(vec![0; total as usize]),
     }
     if let Some(sparse) = &a.sparse {
         let sat = format!("{at}.sparse");
@@ -170,6 +186,7 @@ pub fn read(doc: &Document, index: usize, max_bytes: u64) -> Result<Accessor> {
             n * elem_stored,
             &format!("{sat}.values"),
         )?;
+        let bytes = bytes.to_mut();
         let mut previous = None;
         for k in 0..n {
             let target = read_uint(&idata[k * isize..], ict.0) as usize;
@@ -225,7 +242,7 @@ fn read_uint(b: &[u8], t: ComponentType) -> u32 {
     }
 }
 
-impl Accessor {
+impl Accessor<'_> {
     /// Component `i` (flat index) as stored, widened without scaling.
     pub fn raw(&self, i: usize) -> f64 {
         let s = component_size(self.component_type);
@@ -250,6 +267,40 @@ impl Accessor {
         self.count == 0
     }
 
+    /// The first component (flat index and value, widened without scaling as [`Accessor::raw`]
+    /// gives it) for which `hit` holds. One tight loop per component type, where calling
+    /// [`Accessor::raw`] per component dispatched on the type every time.
+    pub fn find(&self, mut hit: impl FnMut(f64) -> bool) -> Option<(usize, f64)> {
+        fn scan<const N: usize>(
+            bytes: &[u8],
+            widen: impl Fn([u8; N]) -> f64,
+            hit: &mut impl FnMut(f64) -> bool,
+        ) -> Option<(usize, f64)> {
+            bytes
+                .chunks_exact(N)
+                .map(|b| widen(b.try_into().expect("chunks of N bytes")))
+                .enumerate()
+                .find(|&(_, x)| hit(x))
+        }
+        let b = &self.bytes[..];
+        match self.component_type {
+            ComponentType::I8 => scan(b, |x: [u8; 1]| f64::from(x[0] as i8), &mut hit),
+            ComponentType::U8 => scan(b, |x: [u8; 1]| f64::from(x[0]), &mut hit),
+            ComponentType::I16 => scan(b, |x| f64::from(i16::from_le_bytes(x)), &mut hit),
+            ComponentType::U16 => scan(b, |x| f64::from(u16::from_le_bytes(x)), &mut hit),
+            ComponentType::U32 => scan(b, |x| f64::from(u32::from_le_bytes(x)), &mut hit),
+            ComponentType::F32 => scan(b, |x| f64::from(f32::from_le_bytes(x)), &mut hit),
+        }
+    }
+
+    /// Calls `visit` with every component in order (widened as [`Accessor::find`] does).
+    pub fn for_each(&self, mut visit: impl FnMut(f64)) {
+        self.find(|x| {
+            visit(x);
+            false
+        });
+    }
+
     /// Every component as `f32`, normalized integers mapped as the spec says
     /// (e.g. `max(c / 127, -1)` for signed bytes); floats are bit-exact.
     pub fn to_f32(&self) -> Vec<f32> {
@@ -268,13 +319,29 @@ impl Accessor {
             (true, ComponentType::U16) => 65535.0,
             (true, _) => 4294967295.0,
         };
-        (0..self.len())
-            .map(|i| ((self.raw(i) / scale).max(-1.0)) as f32)
-            .collect()
+        let mut out = Vec::with_capacity(self.len());
+        self.for_each(|x| out.push(((x / scale).max(-1.0)) as f32));
+        out
     }
 
     /// Every component as `u32` (for indices, joints and integer IDs).
     pub fn to_u32(&self) -> Vec<u32> {
-        (0..self.len()).map(|i| self.raw(i) as u32).collect()
+        let b = &self.bytes[..];
+        match self.component_type {
+            ComponentType::U8 => b.iter().map(|&x| u32::from(x)).collect(),
+            ComponentType::U16 => b
+                .chunks_exact(2)
+                .map(|x| u32::from(u16::from_le_bytes([x[0], x[1]])))
+                .collect(),
+            ComponentType::U32 => b
+                .chunks_exact(4)
+                .map(|x| u32::from_le_bytes([x[0], x[1], x[2], x[3]]))
+                .collect(),
+            _ => {
+                let mut out = Vec::with_capacity(self.len());
+                self.for_each(|x| out.push(x as u32));
+                out
+            }
+        }
     }
 }

@@ -18,6 +18,12 @@ pub(crate) enum BufferData {
     Floats(Vec<f32>),
     /// 32-bit unsigned integers (indices), under the same condition as `Floats`.
     Words(Vec<u32>),
+    /// A range of a file read whole: a GLB's BIN chunk, left where the read put it rather than
+    /// copied out of the file's bytes (tens of megabytes for a large scan).
+    FileRange {
+        file: Arc<Vec<u8>>,
+        range: Range<usize>,
+    },
 }
 
 impl BufferData {
@@ -45,6 +51,7 @@ impl BufferData {
             BufferData::Bytes(b) => b,
             BufferData::Floats(v) => meshopt::typed_to_bytes(v),
             BufferData::Words(v) => meshopt::typed_to_bytes(v),
+            BufferData::FileRange { file, range } => &file[range.clone()],
         }
     }
 

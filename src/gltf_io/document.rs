@@ -126,7 +126,8 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Document> {
             format!("file is {len} bytes (expected at most {})", opts.max_bytes),
         ));
     }
-    let bytes = std::fs::read(path).map_err(|e| Error::io(&shown, e))?;
+    // Read once, and kept: a GLB's BIN chunk becomes the first buffer where it lies.
+    let bytes = Arc::new(std::fs::read(path).map_err(|e| Error::io(&shown, e))?);
     let named_glb = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
@@ -140,11 +141,22 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Document> {
             p
         }
     });
-    read_bytes(&bytes, dir, opts)
+    parse(&bytes, Some(&bytes), dir, opts)
 }
 
 /// Reads an asset from memory; relative `uri`s resolve against `base_dir` (none: only `data:`).
 pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> Result<Document> {
+    parse(bytes, None, base_dir, opts)
+}
+
+/// Reads an asset from `bytes`; with `file` (the same bytes, shared), a GLB's BIN chunk is
+/// kept in it instead of copied.
+fn parse(
+    bytes: &[u8],
+    file: Option<&Arc<Vec<u8>>>,
+    base_dir: Option<&Path>,
+    opts: &ReadOptions,
+) -> Result<Document> {
     let is_glb = glb::is_glb(bytes);
     let (json, bin) = if is_glb {
         let chunks = glb::split(bytes)?;
@@ -168,16 +180,26 @@ pub fn read_bytes(bytes: &[u8], base_dir: Option<&Path>, opts: &ReadOptions) -> 
     check_typed(&root)?;
     validate::structure(&root, &raw)?;
 
+    let bin = bin.map(|chunk| match file {
+        Some(file) => {
+            let start = chunk.as_ptr() as usize - file.as_ptr() as usize;
+            BufferData::FileRange {
+                file: Arc::clone(file),
+                range: start..start + chunk.len(),
+            }
+        }
+        None => BufferData::Bytes(chunk.to_vec()),
+    });
     let buffers = load_buffers(&root, bin, base_dir, opts)?;
-    validate::buffer_views(&root, &buffers)?;
+    {
+        let views: Vec<&[u8]> = buffers.iter().map(BufferData::as_bytes).collect();
+        validate::buffer_views(&root, &views)?;
+    }
     let mut doc = Document {
         base: Value::Null,
         root,
         raw,
-        buffers: buffers
-            .into_iter()
-            .map(|b| Arc::new(BufferData::Bytes(b)))
-            .collect(),
+        buffers: buffers.into_iter().map(Arc::new).collect(),
         replaced: Default::default(),
         replaced_accessors: Default::default(),
         base_dir: base_dir.map(Path::to_path_buf),
@@ -332,10 +354,11 @@ fn check_typed(root: &gltf_json::Root) -> Result<()> {
 /// Loads every buffer: the GLB BIN chunk, `data:` URIs and files, checking declared lengths.
 fn load_buffers(
     root: &gltf_json::Root,
-    bin: Option<&[u8]>,
+    mut bin: Option<BufferData>,
     base_dir: Option<&Path>,
     opts: &ReadOptions,
-) -> Result<Vec<Vec<u8>>> {
+) -> Result<Vec<BufferData>> {
+    let has_bin = bin.is_some();
     let mut out = Vec::with_capacity(root.buffers.len());
     for (i, buffer) in root.buffers.iter().enumerate() {
         let at = format!("buffers[{i}]");
@@ -349,7 +372,7 @@ fn load_buffers(
                 ),
             ));
         }
-        let data = match (&buffer.uri, bin) {
+        let data = match (&buffer.uri, has_bin) {
             (Some(u), _) => {
                 let data = uri::load(u, &format!("{at}.uri"), base_dir, &uri::Limits::from(opts))?;
                 if u.starts_with("data:") && data.len() as u64 != declared {
@@ -361,14 +384,14 @@ fn load_buffers(
                         ),
                     ));
                 }
-                data
+                BufferData::Bytes(data)
             }
-            (None, Some(bin)) if i == 0 => bin.to_vec(),
+            (None, true) if i == 0 => bin.take().expect("the BIN chunk, once"),
             (None, _)
                 if meshopt_decode::is_fallback(buffer)
                     || meshopt_decode::only_compressed_views(root, i) =>
             {
-                Vec::new()
+                BufferData::default()
             }
             (None, _) => {
                 return Err(Error::invalid(
@@ -377,7 +400,7 @@ fn load_buffers(
                 ))
             }
         };
-        let placeholder = buffer.uri.is_none() && (i != 0 || bin.is_none());
+        let placeholder = buffer.uri.is_none() && (i != 0 || !has_bin);
         if !placeholder && (data.len() as u64) < declared {
             return Err(Error::invalid(
                 format!("{at}.byteLength"),

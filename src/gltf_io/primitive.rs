@@ -405,7 +405,13 @@ impl Document {
             None => json.get("mode").and_then(Value::as_u64).unwrap_or(4),
         };
         let indices = match mode {
-            4 => list[..list.len() - list.len() % 3].to_vec(),
+            4 => {
+                // A list is its own triangle list: kept, not copied.
+                let whole = list.len() - list.len() % 3;
+                let mut list = list;
+                list.truncate(whole);
+                list
+            }
             5 => (0..list.len().saturating_sub(2))
                 .flat_map(|i| {
                     let odd = i % 2;

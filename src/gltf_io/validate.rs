@@ -339,7 +339,7 @@ fn check_format(
 }
 
 /// Buffer views lie inside their buffers and have legal strides.
-pub fn buffer_views(root: &gltf_json::Root, buffers: &[Vec<u8>]) -> Result<()> {
+pub fn buffer_views(root: &gltf_json::Root, buffers: &[&[u8]]) -> Result<()> {
     for (i, v) in root.buffer_views.iter().enumerate() {
         let at = format!("bufferViews[{i}]");
         let b = v.buffer.value();
@@ -424,7 +424,7 @@ fn carried_accessors(root: &gltf_json::Root) -> Vec<bool> {
 pub fn data(doc: &Document, max_bytes: u64, budget: u64) -> Result<()> {
     let root = &doc.root;
     let carried = carried_accessors(root);
-    let mut decoded: Vec<Option<Accessor>> = vec![None; root.accessors.len()];
+    let mut decoded: Vec<Option<Accessor<'_>>> = vec![None; root.accessors.len()];
     let mut total = 0u64;
     for (i, a) in root.accessors.iter().enumerate() {
         let at = format!("accessors[{i}]");
@@ -435,15 +435,16 @@ pub fn data(doc: &Document, max_bytes: u64, budget: u64) -> Result<()> {
                 format!("the accessors up to this one decode to {total} bytes, over the budget of {budget} for this file's data (expected counts that match the data)"),
             ));
         }
+        // Read in place where the data is tightly packed: checking copies nothing.
         let acc = accessor::read(doc, i, max_bytes)?;
         if acc.component_type == ComponentType::F32 {
-            if let Some(k) = (0..acc.len()).find(|k| !acc.raw(*k).is_finite()) {
+            if let Some((k, x)) = acc.find(|x| !x.is_finite()) {
                 return Err(Error::invalid(
                     &at,
                     format!(
                         "element {} holds {} (expected finite numbers)",
                         k / acc.components,
-                        acc.raw(k)
+                        x
                     ),
                 ));
             }
@@ -474,14 +475,11 @@ pub fn data(doc: &Document, max_bytes: u64, budget: u64) -> Result<()> {
                     ComponentType::U16 => 65535.0,
                     _ => 4294967295.0,
                 };
-                for k in 0..acc.len() {
-                    let v = acc.raw(k);
-                    if v == restart || v >= vertices as f64 {
-                        return Err(Error::invalid(
-                            format!("{at}.indices"),
-                            format!("index {v} at position {k} (expected a vertex below {vertices}, not the restart value {restart})"),
-                        ));
-                    }
+                if let Some((k, v)) = acc.find(|v| v == restart || v >= vertices as f64) {
+                    return Err(Error::invalid(
+                        format!("{at}.indices"),
+                        format!("index {v} at position {k} (expected a vertex below {vertices}, not the restart value {restart})"),
+                    ));
                 }
             }
             for (sem, ix) in &prim.attributes {
@@ -502,11 +500,12 @@ pub fn data(doc: &Document, max_bytes: u64, budget: u64) -> Result<()> {
 fn check_bounds(a: &gltf_json::Accessor, acc: &Accessor, carried: bool, at: &str) -> Result<()> {
     let mut actual_min = vec![f64::INFINITY; acc.components];
     let mut actual_max = vec![f64::NEG_INFINITY; acc.components];
-    for k in 0..acc.len() {
-        let c = k % acc.components;
-        actual_min[c] = actual_min[c].min(acc.raw(k));
-        actual_max[c] = actual_max[c].max(acc.raw(k));
-    }
+    let mut c = 0;
+    acc.for_each(|x| {
+        actual_min[c] = actual_min[c].min(x);
+        actual_max[c] = actual_max[c].max(x);
+        c = if c + 1 == acc.components { 0 } else { c + 1 };
+    });
     for (key, declared, actual) in [("min", &a.min, &actual_min), ("max", &a.max, &actual_max)] {
         let Some(declared) = declared else { continue };
         let values: Option<Vec<f64>> = declared
@@ -545,9 +544,22 @@ fn check_bounds(a: &gltf_json::Accessor, acc: &Accessor, carried: bool, at: &str
     Ok(())
 }
 
-fn unit_vectors(acc: &Accessor, at: &str, tangent: bool) -> Result<()> {
-    let v = acc.to_f32();
+fn unit_vectors(acc: &Accessor<'_>, at: &str, tangent: bool) -> Result<()> {
     let n = acc.components;
+    if !tangent {
+        // Only finiteness matters for a normal (see below): checked in place, uncopied.
+        return match acc.find(|x| !x.is_finite()) {
+            Some((k, _)) => Err(Error::invalid(
+                at,
+                format!(
+                    "element {} is not finite (expected a unit vector)",
+                    k / n.max(1)
+                ),
+            )),
+            None => Ok(()),
+        };
+    }
+    let v = acc.to_f32();
     for (e, chunk) in v.chunks_exact(n).enumerate() {
         if chunk.iter().any(|x| !x.is_finite()) {
             return Err(Error::invalid(
@@ -584,7 +596,7 @@ fn skin_data<'a>(
     mesh: usize,
     prim: &gltf_json::mesh::Primitive,
     at: &str,
-    get: &dyn Fn(usize) -> &'a Accessor,
+    get: &dyn Fn(usize) -> &'a Accessor<'a>,
 ) -> Result<()>
 where
 {

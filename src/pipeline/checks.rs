@@ -28,7 +28,20 @@ const EXAMPLES: usize = 3;
 /// `index`), each naming the fallback applied.
 pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warning> {
     let mut out = Vec::new();
-    let degenerate = Tally::of(topo.degenerate.len(), |t| topo.degenerate[t]);
+    // One parallel pass over the triangles for every per-triangle test.
+    let sliver_cos = SLIVER_ANGLE.cos();
+    let [degenerate, slivers, facing_away] = Tally::of_each(mesh.triangles.len(), |t| {
+        if topo.degenerate[t] {
+            return [true, false, false];
+        }
+        let tri = mesh.triangles[t];
+        let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+        let face = (b - a).cross(c - a);
+        let away = tri
+            .iter()
+            .all(|&v| mesh.normals[v as usize].dot(face) < 0.0);
+        [false, largest_angle_cosine([a, b, c]) > sliver_cos, away]
+    });
     if degenerate.count > 0 {
         out.push(Warning::DegenerateTriangles {
             mesh: index,
@@ -36,11 +49,6 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
             triangles: degenerate.examples().to_vec(),
         });
     }
-
-    let sliver_cos = SLIVER_ANGLE.cos();
-    let slivers = Tally::of(mesh.triangles.len(), |t| {
-        !topo.degenerate[t] && largest_angle_cosine(mesh, t) > sliver_cos
-    });
     if slivers.count > 0 {
         out.push(Warning::SliverTriangles {
             mesh: index,
@@ -74,15 +82,6 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         });
     }
 
-    let facing_away = Tally::of(mesh.triangles.len(), |t| {
-        let tri = mesh.triangles[t];
-        let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
-        let face = (b - a).cross(c - a);
-        !topo.degenerate[t]
-            && tri
-                .iter()
-                .all(|&v| mesh.normals[v as usize].dot(face) < 0.0)
-    });
     if facing_away.count > 0 {
         out.push(Warning::NormalsFacingAway {
             mesh: index,
@@ -91,15 +90,21 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         });
     }
 
-    let kind_of = |e: usize| topo.edge_kind(EdgeId(e as u32));
-    let boundary = Tally::of(topo.edge_count(), |e| kind_of(e) == EdgeKind::Boundary).count;
-    if boundary > 0 {
+    // And one over the edges.
+    let [boundary, non_manifold, flipped] = Tally::of_each(topo.edge_count(), |e| {
+        match topo.edge_kind(EdgeId(e as u32)) {
+            EdgeKind::Boundary => [true, false, false],
+            EdgeKind::NonManifold => [false, true, false],
+            EdgeKind::Interior => [false, false, same_direction(topo, e)],
+            EdgeKind::Degenerate => [false; 3],
+        }
+    });
+    if boundary.count > 0 {
         out.push(Warning::BoundaryEdges {
             mesh: index,
-            count: boundary,
+            count: boundary.count,
         });
     }
-    let non_manifold = Tally::of(topo.edge_count(), |e| kind_of(e) == EdgeKind::NonManifold);
     if non_manifold.count > 0 {
         out.push(Warning::NonManifoldEdges {
             mesh: index,
@@ -108,9 +113,6 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         });
     }
 
-    let flipped = Tally::of(topo.edge_count(), |e| {
-        kind_of(e) == EdgeKind::Interior && same_direction(topo, e)
-    });
     if flipped.count > 0 {
         out.push(Warning::OppositeWindingEdges {
             mesh: index,
@@ -161,12 +163,44 @@ impl Tally {
                 t
             })
             .reduce(Tally::default, |mut a, b| {
-                for &i in b.examples() {
-                    a.add(i);
-                }
-                a.count += b.count - b.examples().len();
+                a.merge(&b);
                 a
             })
+    }
+
+    /// [`Tally::of`] for `N` tests at once, in one pass: `hit(i)[k]` says whether `i` passes
+    /// test `k`.
+    fn of_each<const N: usize>(n: usize, hit: impl Fn(usize) -> [bool; N] + Sync) -> [Tally; N] {
+        (0..n)
+            .into_par_iter()
+            .fold(
+                || [Tally::default(); N],
+                |mut t, i| {
+                    for (k, passed) in hit(i).into_iter().enumerate() {
+                        if passed {
+                            t[k].add(i);
+                        }
+                    }
+                    t
+                },
+            )
+            .reduce(
+                || [Tally::default(); N],
+                |mut a, b| {
+                    for (a, b) in a.iter_mut().zip(&b) {
+                        a.merge(b);
+                    }
+                    a
+                },
+            )
+    }
+
+    /// Adds `later` (a tally of larger indices than any in `self`).
+    fn merge(&mut self, later: &Tally) {
+        for &i in later.examples() {
+            self.add(i);
+        }
+        self.count += later.count - later.examples().len();
     }
 
     /// Counts `i`, keeping it as an example if it is among the smallest seen; indices must come
@@ -183,11 +217,10 @@ impl Tally {
     }
 }
 
-/// The cosine of the smallest angle of triangle `t`: comparing cosines instead of angles spares
-/// three arc cosines per triangle, and the order is the same (the cosine falls as the angle
-/// grows).
-fn largest_angle_cosine(mesh: &TriMesh, t: usize) -> f64 {
-    let p: [DVec3; 3] = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
+/// The cosine of the smallest angle of the triangle with corners `p`: comparing cosines instead
+/// of angles spares three arc cosines per triangle, and the order is the same (the cosine falls
+/// as the angle grows).
+fn largest_angle_cosine(p: [DVec3; 3]) -> f64 {
     (0..3)
         .map(|k| {
             let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);

@@ -10,6 +10,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use glam::DVec3;
+use rayon::prelude::*;
 use serde_json::Value;
 
 use super::density::Density;
@@ -18,7 +19,7 @@ use super::morph;
 use super::primitive_out::{self, Prepared};
 use super::report::{EdgeFigures, LodReport, MeshReport, PrimitiveReport};
 use super::warning::{merge_target_warnings, Warning};
-use crate::gltf_io::{self, PrimitiveData};
+use crate::gltf_io::{self, semantic, PrimitiveData, Values};
 use crate::mesh::TriMesh;
 use crate::options::Options;
 use crate::sharpness::{AssetSharpness, EdgeParams, EffectiveH, MeshContext, PrimitiveContext};
@@ -83,20 +84,28 @@ pub(super) struct Resolved {
 }
 
 /// Checks and joins the primitives of `input`, welds them and resolves per-edge h; warnings
-/// go to `warnings`.
+/// go to `warnings`. The primitives' decoded arrays move out of `input` (into the result).
 pub(super) fn resolve(
-    input: &MeshInput,
+    input: &mut MeshInput,
     sharpness: &AssetSharpness,
     options: &Options,
     asset: &Path,
     warnings: &mut Vec<Warning>,
 ) -> Result<Resolved, Error> {
-    let mut prepared: Vec<Prepared> = input
-        .primitives
-        .iter()
-        .map(|p| prepare(input.mesh, p, options.crease_angle, warnings))
-        .collect::<Result<_, _>>()
-        .map_err(|e| Error::gltf(asset, e))?;
+    let mut prepared: Vec<Prepared> = Vec::with_capacity(input.primitives.len());
+    for p in &mut input.primitives {
+        let data = std::mem::replace(
+            &mut p.data,
+            PrimitiveData {
+                attributes: Vec::new(),
+                indices: Vec::new(),
+                targets: Vec::new(),
+            },
+        );
+        let prep = prepare(input.mesh, p, data, options.crease_angle, warnings)
+            .map_err(|e| Error::gltf(asset, e))?;
+        prepared.push(prep);
+    }
     assign_offsets(&mut prepared);
     // Before the join, which moves the primitives' vertices out.
     let contexts: Vec<PrimitiveContext> = input
@@ -151,9 +160,9 @@ pub(super) fn resolve(
     })
 }
 
-/// Smooths one mesh at `level`.
+/// Smooths one mesh at `level`; its decoded arrays are freed as they are used.
 pub fn smooth_mesh(
-    input: &MeshInput,
+    mut input: MeshInput,
     sharpness: &AssetSharpness,
     level: u32,
     options: &Options,
@@ -172,7 +181,13 @@ pub fn smooth_mesh(
         groups,
         topo,
         params,
-    } = resolve(input, sharpness, options, asset, &mut report.warnings.0)?;
+    } = resolve(
+        &mut input,
+        sharpness,
+        options,
+        asset,
+        &mut report.warnings.0,
+    )?;
     report.times.sharpness = lap(&clock, 0.0);
     stop_if_cancelled(options, asset)?;
     // Only the effective widths are read from here on: the requested h and where each came
@@ -295,7 +310,7 @@ pub fn smooth_mesh(
             if k == 0 {
                 report.primitives.push(PrimitiveReport {
                     primitive: input.primitives[j].index,
-                    triangles_in: prep.data.indices.len() / 3,
+                    triangles_in: prep.triangles.len(),
                     vertices_in: prep.source_vertex_count,
                     triangles_out: d.indices.len() / 3,
                     vertices_out: d.positions.len(),
@@ -397,53 +412,57 @@ pub(super) fn build_surface(
 }
 
 /// Checks a primitive's positions and normals, generating normals where there are none.
+///
+/// Takes the primitive's arrays: they move into the result instead of being copied, and the
+/// positions and normals, converted to f64 here for the surface, leave them (only their names
+/// and the input normals' exact bits are read later), so no per-vertex array is held twice.
 fn prepare(
     mesh: usize,
     input: &PrimitiveInput,
+    data: PrimitiveData,
     crease_angle: f64,
     warnings: &mut Vec<Warning>,
 ) -> Result<Prepared, gltf_io::Error> {
     let at = format!("meshes[{mesh}].primitives[{}]", input.index);
-    let data = &input.data;
     let positions = data.positions(&at)?;
     let vertex_count = positions.len() / 3;
-    let triangles: Vec<[u32; 3]> = data
-        .indices
-        .chunks_exact(3)
-        .map(|t| [t[0], t[1], t[2]])
-        .collect();
     if let Some(bad) = data.indices.iter().find(|&&i| i as usize >= vertex_count) {
         return Err(gltf_io::Error::invalid(
             format!("{at}.indices"),
             format!("index {bad} is out of range (expected below the vertex count {vertex_count})"),
         ));
     }
+    let triangles: Vec<[u32; 3]> = data
+        .indices
+        .par_chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .collect();
     let points: Vec<DVec3> = positions
-        .chunks_exact(3)
+        .par_chunks_exact(3)
         .map(|p| DVec3::new(p[0].into(), p[1].into(), p[2].into()))
         .collect();
-    let input_normals = data.normals();
-    match input_normals {
+    let prepared = match data.normals() {
         Some(n) => {
-            let raw: Vec<DVec3> = n
-                .chunks_exact(3)
-                .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
+            let raw =
+                |v: usize| DVec3::new(n[3 * v].into(), n[3 * v + 1].into(), n[3 * v + 2].into());
+            let mut normals: Vec<DVec3> = (0..n.len() / 3)
+                .into_par_iter()
+                .map(|v| raw(v).normalize_or_zero())
                 .collect();
-            let mut normals: Vec<DVec3> = raw.iter().map(|d| d.normalize_or_zero()).collect();
-            let rescaled: Vec<usize> = (0..raw.len())
-                .filter(|&v| normals[v] != DVec3::ZERO && !unit_to_validator(raw[v]))
-                .collect();
-            if let Some(&first) = rescaled.first() {
+            let rescaled = |v: usize| normals[v] != DVec3::ZERO && !unit_to_validator(raw(v));
+            let (count, first) = first_and_count(normals.len(), rescaled);
+            if let Some(first) = first {
                 warnings.push(Warning::NormalsRescaled {
                     mesh,
                     primitive: input.index,
                     accessor: input.normal_accessor,
-                    count: rescaled.len(),
+                    count,
                     vertex: first,
-                    length: raw[first].length() as f32,
+                    length: raw(first).length() as f32,
                 });
             }
             let broken: Vec<usize> = (0..normals.len())
+                .into_par_iter()
                 .filter(|&v| normals[v] == DVec3::ZERO || !normals[v].is_finite())
                 .collect();
             if let Some(&first) = broken.first() {
@@ -456,13 +475,7 @@ fn prepare(
                     vertex: first,
                 });
             }
-            Ok(Prepared::new(
-                data.clone(),
-                points,
-                normals,
-                triangles,
-                input.needs_tangents,
-            ))
+            Prepared::new(data, points, normals, triangles, input.needs_tangents)
         }
         None => {
             let generated = normals::generate(&points, &triangles, crease_angle);
@@ -471,14 +484,38 @@ fn prepare(
                 primitive: input.index,
                 crease_angle,
             });
-            Ok(Prepared::with_generated_normals(
-                data,
-                &points,
-                generated,
-                input.needs_tangents,
-            ))
+            Prepared::with_generated_normals(&data, &points, generated, input.needs_tangents)
+        }
+    };
+    Ok(without_core_values(prepared))
+}
+
+/// `prepared` with the f32 positions, normals and indices of its input arrays freed: from here
+/// on they are read from the f64 copies and the triangle list (and the input normals' bits from
+/// `exact_normals`), while the attributes keep their names and order, which the output follows.
+fn without_core_values(mut prepared: Prepared) -> Prepared {
+    for a in &mut prepared.data.attributes {
+        if a.name == semantic::POSITION || a.name == semantic::NORMAL {
+            a.values = match a.values {
+                Values::Float(_) => Values::Float(Vec::new()),
+                Values::Uint(_) => Values::Uint(Vec::new()),
+            };
         }
     }
+    prepared.data.indices = Vec::new();
+    prepared
+}
+
+/// How many of `0..n` pass `hit`, and the first that does, tested in parallel.
+fn first_and_count(n: usize, hit: impl Fn(usize) -> bool + Sync) -> (usize, Option<usize>) {
+    (0..n)
+        .into_par_iter()
+        .filter(|&v| hit(v))
+        .fold(
+            || (0, None),
+            |(c, f): (usize, Option<usize>), v| (c + 1, f.or(Some(v))),
+        )
+        .reduce(|| (0, None), |a, b| (a.0 + b.0, a.1.or(b.1)))
 }
 
 /// Whether `n` is unit length within the Khronos validator's tolerance for unit vectors.

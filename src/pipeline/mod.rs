@@ -241,11 +241,11 @@ fn smooth_meshes(
         if batch.is_empty() {
             break;
         }
+        // Each mesh's decoded arrays are freed inside as they are used.
         let outputs: Vec<Result<MeshOutput, Error>> = batch
-            .par_iter()
+            .into_par_iter()
             .map(|m| smooth_one(m, &sharpness, options, asset))
             .collect();
-        drop(batch);
         for out in outputs {
             // Storing the new arrays in the document's buffer is the first half of writing.
             let store_start = Instant::now();
@@ -294,7 +294,7 @@ fn smooth_document(
     let (sharpness, report, inputs) = prepare_document(doc, asset, options)?;
     // The meshes are independent: smooth them in parallel, collect in file order.
     let outputs = inputs
-        .par_iter()
+        .into_par_iter()
         .map(|m| smooth_one(m, &sharpness, options, asset))
         .collect();
     Ok((report, outputs))
@@ -328,7 +328,7 @@ fn prepare_document(
 
 /// One mesh smoothed under its own options (the sidecar's density keys over `options`).
 fn smooth_one(
-    m: &MeshInput,
+    m: MeshInput,
     sharpness: &AssetSharpness,
     options: &Options,
     asset: &Path,
@@ -434,7 +434,7 @@ pub fn explain_h(input: &Path, options: &Options, which: &str) -> Result<Vec<Str
         });
     };
     let mut warnings = Vec::new();
-    let resolved = mesh_job::resolve(mesh, &sharpness, options, input, &mut warnings)?;
+    let resolved = mesh_job::resolve(&mut mesh.clone(), &sharpness, options, input, &mut warnings)?;
     let rows = explain_rows(&resolved.params, &resolved.topo);
     Ok(rows
         .iter()
@@ -464,9 +464,9 @@ pub fn resolved_edges(
     let sharpness = asset_sharpness(doc, asset, options)?;
     // Meshes are independent, as in processing: resolved in parallel, collected in file order.
     mesh_inputs(doc, asset)?
-        .par_iter()
-        .map(|m| {
-            let resolved = mesh_job::resolve(m, &sharpness, options, asset, &mut Vec::new())?;
+        .into_par_iter()
+        .map(|mut m| {
+            let resolved = mesh_job::resolve(&mut m, &sharpness, options, asset, &mut Vec::new())?;
             Ok(ResolvedEdges {
                 mesh: m.mesh,
                 topo: resolved.topo,

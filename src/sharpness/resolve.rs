@@ -10,7 +10,7 @@ use super::error::{Location, Problem, SharpnessError};
 use super::explain::HSource;
 use super::extras::{parse_block, Owner};
 use super::naming::EdgeNamer;
-use super::rules::{dihedral_degrees, is_crease, is_hard_edge};
+use super::rules::{is_hard_edge, CreaseTest};
 use super::{mesh_label, AssetSharpness, EdgeParams, EffectiveH, MeshContext, SharpnessWarning};
 use crate::mesh::TriMesh;
 use crate::topology::{Edge, EdgeId, EdgeKind, Topology};
@@ -96,6 +96,17 @@ pub(crate) fn resolve(
         p => extras_h_of_prim[p as usize],
     };
 
+    // The crease rule of each side's angle, set up once rather than per edge.
+    let default_test = CreaseTest::new(asset.defaults.crease_angle);
+    let test_of =
+        |angle: Option<&Located<f64>>| angle.map_or(default_test, |a| CreaseTest::new(a.value));
+    let test_of_prim: Vec<CreaseTest> = crease_of_prim.iter().map(|a| test_of(*a)).collect();
+    let outside_test = test_of(outside_crease);
+    let side_test = |p: u32| match p {
+        NO_PRIMITIVE => outside_test,
+        p => test_of_prim[p as usize],
+    };
+
     // Edges are independent: resolved in parallel, collected in edge order.
     let source_of = |(e, edge): (usize, Edge<'_>)| {
         let id = EdgeId(e as u32);
@@ -115,8 +126,7 @@ pub(crate) fn resolve(
             sharpest(sides(), |p| {
                 side_crease(p).map_or(asset.defaults.crease_angle, |a| a.value)
             })
-            .and_then(side_crease),
-            asset.defaults.crease_angle,
+            .map_or((default_test, None), |p| (side_test(p), side_crease(p))),
         ) {
             (0.0, rule)
         } else if asset.defaults.keep_hard_edges && is_hard_edge(&edge) {
@@ -181,21 +191,20 @@ fn sharpest(sides: impl Iterator<Item = u32>, value: impl Fn(u32) -> f64) -> Opt
         .map(|(_, p)| p)
 }
 
-/// The crease rule for one edge: the sharpest crease angle over its sides (`side_angle`, the
-/// options' when that side sets none), and h = 0 if the faces meet at more than that.
+/// The crease rule for one edge under the sharpest of its sides' crease angles (`side`: that
+/// side's rule, and where its angle was set, `None` for the options' angle): h = 0 if the faces
+/// meet at more than that angle.
 fn crease_rule(
     edge: &Edge<'_>,
     topo: &Topology,
-    side_angle: Option<&Located<f64>>,
-    default_angle: f64,
+    side: (CreaseTest, Option<&Located<f64>>),
 ) -> Option<HSource> {
-    let dihedral = dihedral_degrees(edge, topo)?;
-    let (crease_angle, set_by) =
-        side_angle.map_or((default_angle, None), |a| (a.value, Some(a.at.clone())));
-    is_crease(dihedral, crease_angle).then_some(HSource::Crease {
+    let (test, set_by) = side;
+    let dihedral = test.dihedral_if_crease(edge, topo)?;
+    Some(HSource::Crease {
         dihedral,
-        crease_angle,
-        set_by,
+        crease_angle: test.crease_angle(),
+        set_by: set_by.map(|a| a.at.clone()),
     })
 }
 

@@ -6,13 +6,18 @@
 //!
 //! The mesh is a 1 280-triangle geodesic sphere at level 16 (327 680 output triangles): small
 //! enough for criterion's repetitions, large enough that every stage runs in parallel blocks.
+//!
+//! The per-input stages have a group of their own, timed per input triangle on an 81 920-triangle
+//! GLB (the fixture icosahedron smoothed at level 64): reading the file (parse, validate, load),
+//! and reading it through to every edge's resolved h (decode, join, weld and topology, the
+//! geometry checks, h), which is what a large input costs before its surface is built.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use g2tess::gltf_io::{self, ReadOptions, WriteOptions};
 use g2tess::mesh::TriMesh;
 use g2tess::optimize;
 use g2tess::options::Options;
-use g2tess::pipeline::{process_document, process_file};
+use g2tess::pipeline::{process_document, process_file, resolved_edges};
 use g2tess::surface::{G2Surface, Profile, Surface, SurfacePoint};
 use g2tess::tessellate::tessellate;
 use g2tess::topology::Topology;
@@ -77,6 +82,33 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("whole file", |b| {
         b.iter(|| process_file(&input, &output, &options).expect("smooths"))
+    });
+    g.finish();
+    per_input(c);
+}
+
+/// The stages whose cost grows with the input triangles rather than the output's.
+fn per_input(c: &mut Criterion) {
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/icosahedron.glb");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = dir.path().join("input.glb");
+    let mut make = Options::default();
+    make.level = 64;
+    let made = process_file(&fixture, &input, &make).expect("smooths");
+    let triangles = made.triangles_out;
+    let options = Options::default();
+
+    let mut g = c.benchmark_group("per input triangle");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(triangles as u64));
+    g.bench_function("read", |b| {
+        b.iter(|| black_box(gltf_io::read(&input, &ReadOptions::default()).expect("reads")))
+    });
+    g.bench_function("read, decode, weld, checks, h", |b| {
+        b.iter(|| {
+            let doc = gltf_io::read(&input, &ReadOptions::default()).expect("reads");
+            black_box(resolved_edges(&doc, &input, &options).expect("resolves"))
+        })
     });
     g.finish();
 }
