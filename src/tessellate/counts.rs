@@ -67,6 +67,11 @@ pub struct ChordErrors {
     /// coordinate the probe saw, `√3 · 2⁻²⁴ · max |x|` (1e-7 on the unit sphere, where level
     /// 16 of a 10k icosphere reaches 2.4e-6).
     pub rounding: f64,
+    /// The smallest chord error that means anything for this mesh: eight `f32` units in the
+    /// last place of the largest coordinate, `2⁻²⁰ · max |x|`. Constants at or below it are
+    /// rounding noise (a flat part probed in floating point has them) and count as 0, and no
+    /// tolerance below it is sought, so a budget never refines a flat part for nothing.
+    pub floor: f64,
 }
 
 /// Segment counts of one mesh: per welded edge and per source triangle's interior.
@@ -112,10 +117,13 @@ impl ChordErrors {
             }
         }
         let largest = per_tri.iter().map(|t| t.2).fold(0.0, f64::max);
+        let floor = finite(largest * 2f64.powi(-20));
+        let audible = |c: f64| if c <= floor { 0.0 } else { c };
         ChordErrors {
-            triangles: per_tri.iter().map(|t| t.0).collect(),
-            edges,
+            triangles: per_tri.iter().map(|t| audible(t.0)).collect(),
+            edges: edges.into_iter().map(audible).collect(),
             rounding: finite(3f64.sqrt() * largest * 2f64.powi(-24)),
+            floor,
         }
     }
 
@@ -199,9 +207,10 @@ impl ChordErrors {
         counts
     }
 
-    /// The largest tolerance (and its counts) whose output has at most `budget` triangles, by
+    /// The smallest tolerance (and its counts) whose output has at most `budget` triangles, by
     /// bisection on the tolerance with the counts alone; when even one segment everywhere is
-    /// over the budget, those counts.
+    /// over the budget, those counts; when the counts at the noise floor (or at the cap)
+    /// fit, those, so a flat mesh keeps one segment per edge whatever the budget.
     pub fn for_budget(&self, topo: &Topology, budget: u64, cap: u32) -> (f64, SegmentCounts) {
         let largest = self
             .triangles
@@ -212,14 +221,19 @@ impl ChordErrors {
             return (0.0, self.counts(topo, 1.0, cap));
         }
         // At `hi` every count is 1 (the margin of `counts` included); at `lo` every count is
-        // `cap`.
+        // `cap`, or the tolerance is at the noise floor: when that fits, it is the answer (the
+        // smallest counts reaching the finest tolerance that means anything), not the budget.
         let (mut lo, mut hi) = (
-            largest / (4.0 * f64::from(cap * cap)),
+            (largest / (4.0 * f64::from(cap * cap))).max(self.floor),
             largest * MARGIN * 1.01,
         );
         let mut best = (hi, self.counts(topo, hi, cap));
         if best.1.triangle_count(topo) > budget {
             return best;
+        }
+        let finest = self.counts(topo, lo, cap);
+        if finest.triangle_count(topo) <= budget {
+            return (lo, finest);
         }
         for _ in 0..48 {
             let mid = (lo * hi).sqrt();

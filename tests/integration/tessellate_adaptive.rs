@@ -333,3 +333,28 @@ fn a_budget_is_met_by_the_counts_alone() {
         println!("budget {budget}: {written} triangles at tolerance {tolerance:.3e}");
     }
 }
+
+#[test]
+fn a_budget_leaves_a_flat_mesh_at_one_segment_per_edge() {
+    // A flat plate's chord error is 0 at any count: whatever the budget, the smallest counts
+    // meet it. Its probe sees only rounding (about 1e-17 here), which the search once took for
+    // curvature and refined up to the budget.
+    let mesh = flat_grid(8);
+    let topo = Topology::build(&mesh);
+    let hs = h_all(&topo, 0.2);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let errors = ChordErrors::probe(&mesh, &topo, &surface);
+    for budget in [mesh.triangles.len() as u64, 10_000, 1_000_000] {
+        let (_, counts) = errors.for_budget(&topo, budget, 64);
+        assert_eq!(counts.max(), 1, "budget {budget}");
+        assert_eq!(counts.triangle_count(&topo), mesh.triangles.len() as u64);
+    }
+    // The dome on the same plate still uses its budget.
+    let dome = plate_with_dome();
+    let topo = Topology::build(&dome);
+    let hs = h_all(&topo, 0.2);
+    let surface = G2Surface::new(&dome, &topo, &hs, Profile::C2);
+    let (_, counts) = ChordErrors::probe(&dome, &topo, &surface).for_budget(&topo, 20_000, 64);
+    let written = counts.triangle_count(&topo);
+    assert!(written > 10_000 && written <= 20_000, "{written}");
+}
