@@ -22,9 +22,9 @@ use super::counts::SegmentCounts;
 use super::emit;
 use super::layout::GroupLayout;
 use super::transition::{Pattern, PatternKey};
-use super::{canonical_forward, evaluator, DenseMesh, VertexSource, BLOCK_TRIANGLES};
+use super::{DenseMesh, VertexSource, BLOCK_TRIANGLES};
 use crate::mesh::TriMesh;
-use crate::surface::{LatticePart, Surface, SurfacePoint};
+use crate::surface::Surface;
 use crate::topology::Topology;
 
 /// Tessellates `groups` of `mesh` with `counts`; `h` as for [`super::tessellate`].
@@ -51,7 +51,6 @@ pub fn tessellate_with_counts(
         .par_iter()
         .map(|k| distinct.binary_search(k).expect("every key was built") as u32)
         .collect();
-    let edge_samples = shared_edge_samples(topo, surface, &counts.edges);
     let shared = Shared {
         mesh,
         topo,
@@ -59,66 +58,11 @@ pub fn tessellate_with_counts(
         counts,
         patterns: &patterns,
         pattern_of: &pattern_of,
-        edge_samples: &edge_samples,
     };
     groups
         .par_iter()
         .map(|range| tessellate_group(&shared, h, range.clone()))
         .collect()
-}
-
-/// The samples of every welded edge, `count − 1` per edge from `start[e]`, in the edge's
-/// canonical direction.
-struct EdgeSamples {
-    start: Vec<usize>,
-    positions: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-}
-
-fn shared_edge_samples(topo: &Topology, surface: &dyn Surface, counts: &[u32]) -> EdgeSamples {
-    let mut start = Vec::with_capacity(counts.len() + 1);
-    let mut total = 0usize;
-    for &c in counts {
-        start.push(total);
-        total += c.saturating_sub(1) as usize;
-    }
-    start.push(total);
-    let mut positions = vec![[0.0f32; 3]; total];
-    let mut normals = vec![[0.0f32; 3]; total];
-    let mut slices = Vec::with_capacity(counts.len());
-    let (mut p_rest, mut n_rest) = (&mut positions[..], &mut normals[..]);
-    for e in 0..counts.len() {
-        let len = start[e + 1] - start[e];
-        let (p, pr) = std::mem::take(&mut p_rest).split_at_mut(len);
-        let (n, nr) = std::mem::take(&mut n_rest).split_at_mut(len);
-        (p_rest, n_rest) = (pr, nr);
-        slices.push((e, p, n));
-    }
-    slices.into_par_iter().for_each_init(
-        Vec::new,
-        |values: &mut Vec<SurfacePoint>, (e, positions, normals)| {
-            let Some((tri, k)) = evaluator(topo, e) else {
-                return;
-            };
-            if positions.is_empty() {
-                return;
-            }
-            let n = counts[e];
-            values.clear();
-            surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), values);
-            let forward = canonical_forward(topo, tri, k);
-            for (m, p) in (1..n).zip(values.iter()) {
-                let slot = (if forward { m } else { n - m } - 1) as usize;
-                positions[slot] = p.position.as_vec3().to_array();
-                normals[slot] = p.normal.as_vec3().to_array();
-            }
-        },
-    );
-    EdgeSamples {
-        start,
-        positions,
-        normals,
-    }
 }
 
 /// What every block reads.
@@ -129,7 +73,6 @@ struct Shared<'a> {
     counts: &'a SegmentCounts,
     patterns: &'a [Pattern],
     pattern_of: &'a [u32],
-    edge_samples: &'a EdgeSamples,
 }
 
 impl Shared<'_> {
@@ -199,19 +142,8 @@ fn tessellate_block(
     first_tri: usize,
     mut block: Block<'_>,
 ) {
-    let (mesh, topo, surface, edge_samples) = (
-        shared.mesh,
-        shared.topo,
-        shared.surface,
-        shared.edge_samples,
-    );
-    let mut writer = emit::TriangleWriter::new(
-        mesh,
-        topo,
-        surface,
-        &edge_samples.positions,
-        &edge_samples.normals,
-    );
+    let (mesh, topo, surface) = (shared.mesh, shared.topo, shared.surface);
+    let mut writer = emit::TriangleWriter::new(mesh, topo, surface);
     let mut local: Vec<u32> = Vec::new();
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
@@ -244,7 +176,6 @@ fn tessellate_block(
                 layout.edge_slot[3 * offset + k] as usize,
                 corners[(k + 1) % 3] <= corners[(k + 2) % 3],
                 owns & (8 << k) != 0,
-                |e| edge_samples.start[e],
                 |m| (pattern.edge_start[k] + m - 1) as usize,
                 source,
             );

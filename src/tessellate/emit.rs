@@ -5,8 +5,8 @@
 //! the rest the same way on both paths:
 //! - corners are the input vertices, written by the triangle that owns them;
 //! - edge samples take their position from the welded edge's one evaluating triangle (so a
-//!   welded edge is bit-watertight), either read from a shared pass or evaluated in place by the
-//!   same call, and their normal from this side's own surface (normals differ across a crease);
+//!   welded edge is bit-watertight), evaluated in place by the same call, and their normal from
+//!   this side's own surface (normals differ across a crease);
 //! - interior points are evaluated here, as one lattice part;
 //! - triangles are written by local point, through the local-to-slot map the steps fill.
 
@@ -16,67 +16,27 @@ use crate::mesh::TriMesh;
 use crate::surface::{LatticePart, Surface, SurfacePoint};
 use crate::topology::Topology;
 
-/// Where the positions of edge samples come from.
-pub(super) enum EdgeSamples<'a> {
-    /// Every welded edge's samples, evaluated once beforehand in its canonical direction; the
-    /// edge's run starts where the layout's `samples_of` says.
-    Shared {
-        positions: &'a [[f32; 3]],
-        /// The normals of the evaluating triangle ([`evaluator`]).
-        normals: &'a [[f32; 3]],
-    },
-    /// Evaluated by the triangle that writes them, straight into the output: positions always
-    /// from the welded edge's [`evaluator`] (the same call gives the same bits, so a welded
-    /// edge stays bit-watertight without an array in between), normals from the writing side.
-    /// Only a side that is not the evaluator (a split copy: a seam, a crease, another group)
-    /// evaluates the edge twice.
-    InPlace,
-}
-
 /// What the steps of one triangle read, and the scratch they reuse from triangle to triangle.
 pub(super) struct TriangleWriter<'a> {
     pub mesh: &'a TriMesh,
     pub topo: &'a Topology,
     pub surface: &'a dyn Surface,
-    samples: EdgeSamples<'a>,
     own_edge: Vec<SurfacePoint>,
     evaluator_edge: Vec<SurfacePoint>,
     interior: Vec<SurfacePoint>,
 }
 
 impl<'a> TriangleWriter<'a> {
-    /// A writer that takes edge samples from arrays evaluated beforehand
-    /// ([`EdgeSamples::Shared`]).
-    pub fn new(
-        mesh: &'a TriMesh,
-        topo: &'a Topology,
-        surface: &'a dyn Surface,
-        sample_positions: &'a [[f32; 3]],
-        sample_normals: &'a [[f32; 3]],
-    ) -> Self {
-        let samples = EdgeSamples::Shared {
-            positions: sample_positions,
-            normals: sample_normals,
-        };
-        Self::with_samples(mesh, topo, surface, samples)
-    }
-
-    /// A writer that evaluates edge samples where they are written ([`EdgeSamples::InPlace`]).
-    pub fn in_place(mesh: &'a TriMesh, topo: &'a Topology, surface: &'a dyn Surface) -> Self {
-        Self::with_samples(mesh, topo, surface, EdgeSamples::InPlace)
-    }
-
-    fn with_samples(
-        mesh: &'a TriMesh,
-        topo: &'a Topology,
-        surface: &'a dyn Surface,
-        samples: EdgeSamples<'a>,
-    ) -> Self {
+    /// A writer for triangles of `surface`. Edge samples are evaluated by the triangle that
+    /// writes them, straight into the output: positions always from the welded edge's
+    /// [`evaluator`] (the same call gives the same bits, so a welded edge stays bit-watertight
+    /// without an array in between), normals from the writing side. Only a side that is not
+    /// the evaluator (a split copy: a seam, a crease, another group) evaluates the edge twice.
+    pub fn new(mesh: &'a TriMesh, topo: &'a Topology, surface: &'a dyn Surface) -> Self {
         TriangleWriter {
             mesh,
             topo,
             surface,
-            samples,
             own_edge: Vec::new(),
             evaluator_edge: Vec::new(),
             interior: Vec::new(),
@@ -106,8 +66,8 @@ impl<'a> TriangleWriter<'a> {
 
     /// The `n − 1` samples of edge `k` of `tri`: sample `m` (1 to n − 1, from corner
     /// `(k + 1) % 3`) is local point `point(m)`; the edge's output slots start at `first_slot`
-    /// and run from its lower input vertex (`ascending`: that is corner `(k + 1) % 3`); the
-    /// shared samples of its welded edge `e` start at `samples_of(e)`. Written if `owned`.
+    /// and run from its lower input vertex (`ascending`: that is corner `(k + 1) % 3`). Written
+    /// if `owned`.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn edge(
@@ -120,7 +80,6 @@ impl<'a> TriangleWriter<'a> {
         first_slot: usize,
         ascending: bool,
         owned: bool,
-        samples_of: impl Fn(usize) -> usize,
         point: impl Fn(u32) -> usize,
         source: impl Fn(usize) -> VertexSource,
     ) {
@@ -135,63 +94,38 @@ impl<'a> TriangleWriter<'a> {
         let forward = canonical_forward(self.topo, tri, k);
         let evaluated_by = evaluator(self.topo, e);
         let evaluated_here = evaluated_by == Some((tri, k));
-        let in_place = matches!(self.samples, EdgeSamples::InPlace);
-        if !evaluated_here || in_place {
-            self.own_edge.clear();
-            self.surface.evaluate_lattice_part(
-                tri,
-                n,
-                LatticePart::Edge(k as u8),
-                &mut self.own_edge,
-            );
+        self.own_edge.clear();
+        self.surface
+            .evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut self.own_edge);
+        // The evaluator's run, and whether it is walked the same way as this side's.
+        let mut same_direction = true;
+        if !evaluated_here {
+            if let Some((te, ke)) = evaluated_by {
+                self.evaluator_edge.clear();
+                self.surface.evaluate_lattice_part(
+                    te,
+                    n,
+                    LatticePart::Edge(ke as u8),
+                    &mut self.evaluator_edge,
+                );
+                same_direction = canonical_forward(self.topo, te, ke) == forward;
+            }
         }
-        match self.samples {
-            EdgeSamples::Shared { positions, normals } => {
-                let first_sample = samples_of(e);
-                for m in 1..n {
-                    let (p, s) = (point(m), slot(m));
-                    local[p] = s as u32;
-                    let welded = first_sample + (if forward { m } else { n - m } - 1) as usize;
-                    let normal = if evaluated_here {
-                        normals[welded]
-                    } else {
-                        self.own_edge[(m - 1) as usize].normal.as_vec3().to_array()
-                    };
-                    block.put(s, positions[welded], normal, source(p));
-                }
-            }
-            EdgeSamples::InPlace => {
-                // The evaluator's run, and whether it is walked the same way as this side's.
-                let mut same_direction = true;
-                if !evaluated_here {
-                    if let Some((te, ke)) = evaluated_by {
-                        self.evaluator_edge.clear();
-                        self.surface.evaluate_lattice_part(
-                            te,
-                            n,
-                            LatticePart::Edge(ke as u8),
-                            &mut self.evaluator_edge,
-                        );
-                        same_direction = canonical_forward(self.topo, te, ke) == forward;
-                    }
-                }
-                let positions = if evaluated_here || evaluated_by.is_none() {
-                    &self.own_edge
-                } else {
-                    &self.evaluator_edge
-                };
-                for m in 1..n {
-                    let (p, s) = (point(m), slot(m));
-                    local[p] = s as u32;
-                    let at = (if same_direction { m } else { n - m } - 1) as usize;
-                    block.put(
-                        s,
-                        positions[at].position.as_vec3().to_array(),
-                        self.own_edge[(m - 1) as usize].normal.as_vec3().to_array(),
-                        source(p),
-                    );
-                }
-            }
+        let positions = if evaluated_here || evaluated_by.is_none() {
+            &self.own_edge
+        } else {
+            &self.evaluator_edge
+        };
+        for m in 1..n {
+            let (p, s) = (point(m), slot(m));
+            local[p] = s as u32;
+            let at = (if same_direction { m } else { n - m } - 1) as usize;
+            block.put(
+                s,
+                positions[at].position.as_vec3().to_array(),
+                self.own_edge[(m - 1) as usize].normal.as_vec3().to_array(),
+                source(p),
+            );
         }
     }
 

@@ -302,7 +302,7 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
     } = *shared;
     let n = plan.n;
     let per_tri_indices = 3 * (n * n) as usize;
-    let mut writer = emit::TriangleWriter::in_place(mesh, topo, surface);
+    let mut writer = emit::TriangleWriter::new(mesh, topo, surface);
     let mut local = vec![0u32; plan.len];
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
@@ -342,7 +342,6 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
                 layout.edge_slot[3 * offset + k] as usize,
                 corners[(k + 1) % 3] <= corners[(k + 2) % 3],
                 owns & (8 << k) != 0,
-                |_| 0,
                 |m| lis[(m - 1) as usize] as usize,
                 source,
             );
