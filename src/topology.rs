@@ -8,6 +8,7 @@
 //! `(k + 1) % 3` (called `i`) to corner `(k + 2) % 3` (called `j`).
 
 use std::fmt;
+use std::ops::Range;
 
 use rayon::prelude::*;
 
@@ -434,67 +435,205 @@ struct Grouped {
 /// Groups every triangle side into welded edges, in canonical (smaller vertex, larger vertex)
 /// order and each edge's uses in (triangle, corner) order.
 ///
-/// A counting sort by the smaller end point puts the uses into one bucket per vertex, already
-/// in use order; each bucket is then sorted by the larger end point alone. Linear in the corners
-/// plus the sort of each vertex's own sides, where a sort of all sides together kept 16-byte
-/// keys for every side.
+/// The smaller end points are cut into ranges, one task each, and every task scans all sides
+/// for its own: a counting sort puts its sides into one bucket per vertex, each side packed in
+/// one `u64` as (larger end point, use), so that sorting a bucket's plain integers orders it by
+/// edge and then by use, with no lookup of the triangles per comparison. Linear in the corners
+/// plus the sort of each vertex's own sides, parallel without a shared write, and the result
+/// does not depend on how the vertices were cut. Each triangle side then finds its edge among
+/// those of its smaller end point (a binary search, so a vertex on 100 000 edges costs a
+/// logarithm, not a scan).
 fn group_uses(tri_verts: &[[VertId; 3]], vertex_count: usize) -> Grouped {
-    let key = |u: EdgeUse| {
-        let (t, k) = u.at();
-        let (a, b) = (tri_verts[t][(k + 1) % 3], tri_verts[t][(k + 2) % 3]);
-        [a.min(b), a.max(b)]
-    };
-    let all = 3 * tri_verts.len();
-    // Bucket ends by smaller end point, then filled backwards so each bucket keeps use order.
-    let mut end = vec![0u32; vertex_count + 1];
-    for v in tri_verts {
-        for k in 0..3 {
-            let (a, b) = (v[(k + 1) % 3], v[(k + 2) % 3]);
-            end[a.min(b).0 as usize] += 1;
-        }
-    }
-    let mut sum = 0;
-    for x in &mut end {
-        sum += *x;
-        *x = sum;
-    }
-    let mut uses = vec![EdgeUse(0); all];
-    for c in (0..all as u32).rev() {
-        let u = EdgeUse(c);
-        let slot = &mut end[key(u)[0].0 as usize];
-        *slot -= 1;
-        uses[*slot as usize] = u;
-    }
-    drop(end);
-    uses.par_chunk_by_mut(|&a, &b| key(a)[0] == key(b)[0])
-        .for_each(|bucket| bucket.sort_unstable_by_key(|&u| (key(u)[1], u)));
-
-    let edge_count = if uses.is_empty() {
-        0
+    let sides = 3 * tri_verts.len();
+    // A few ranges per thread at most: each range reads every side once.
+    let ranges = if sides < PARALLEL_SIDES {
+        1
     } else {
-        1 + (1..all)
-            .into_par_iter()
-            .filter(|&i| key(uses[i]) != key(uses[i - 1]))
-            .count()
+        rayon::current_num_threads().clamp(1, 8)
     };
-    let mut edge_verts = Vec::with_capacity(edge_count);
-    let mut use_start = Vec::with_capacity(edge_count + 1);
-    let mut tri_edges = vec![[EdgeId(0); 3]; tri_verts.len()];
-    for (i, &u) in uses.iter().enumerate() {
-        let k = key(u);
-        if edge_verts.last() != Some(&k) {
-            edge_verts.push(k);
-            use_start.push(i as u32);
-        }
-        let (t, c) = u.at();
-        tri_edges[t][c] = EdgeId(edge_verts.len() as u32 - 1);
-    }
-    use_start.push(all as u32);
+    let cut = |i: usize| i * vertex_count / ranges;
+    let parts: Vec<Part> = (0..ranges)
+        .into_par_iter()
+        .map(|i| Part::of(tri_verts, cut(i)..cut(i + 1)))
+        .collect();
+
+    // The parts side by side, in vertex order: their uses, edges and offsets shifted by what
+    // comes before them, each part copied by its own task.
+    let sums = |len: fn(&Part) -> usize| -> Vec<usize> {
+        let mut at = 0;
+        parts
+            .iter()
+            .map(|p| {
+                at += len(p);
+                at - len(p)
+            })
+            .collect()
+    };
+    let (use_base, edge_base) = (sums(|p| p.sides.len()), sums(|p| p.edge_verts.len()));
+    let edge_count: usize = parts.iter().map(|p| p.edge_verts.len()).sum();
+    let uses = side_by_side(
+        &parts,
+        (EdgeUse(0), None),
+        |p| p.sides.len(),
+        |_, p, out| {
+            for (o, &x) in out.iter_mut().zip(&p.sides) {
+                *o = EdgeUse(x as u32);
+            }
+        },
+    );
+    let edge_verts = side_by_side(
+        &parts,
+        ([VertId(0); 2], None),
+        |p| p.edge_verts.len(),
+        |_, p, out| {
+            out.copy_from_slice(&p.edge_verts);
+        },
+    );
+    let use_start = side_by_side(
+        &parts,
+        (0, Some(sides as u32)),
+        |p| p.use_start.len(),
+        |i, p, out| {
+            for (o, &x) in out.iter_mut().zip(&p.use_start) {
+                *o = use_base[i] as u32 + x;
+            }
+        },
+    );
+    let first_edge = side_by_side(
+        &parts,
+        (0, Some(edge_count as u32)),
+        |p| p.first_edge.len(),
+        |i, p, out| {
+            for (o, &x) in out.iter_mut().zip(&p.first_edge) {
+                *o = edge_base[i] as u32 + x;
+            }
+        },
+    );
+    drop(parts);
+
+    let tri_edges = tri_verts
+        .par_iter()
+        .map(|v| {
+            std::array::from_fn(|k| {
+                let (a, b) = ordered(v[(k + 1) % 3], v[(k + 2) % 3]);
+                let from = first_edge[a.0 as usize] as usize;
+                let of_a = &edge_verts[from..first_edge[a.0 as usize + 1] as usize];
+                EdgeId((from + of_a.partition_point(|e| e[1] < b)) as u32)
+            })
+        })
+        .collect();
     Grouped {
         uses,
         edge_verts,
         use_start,
         tri_edges,
+    }
+}
+
+/// Fewer triangle sides than this are grouped by one task: splitting them costs more than it
+/// saves.
+const PARALLEL_SIDES: usize = 1 << 16;
+
+/// One array of the parts' pieces one after another, then `closing` if there is one:
+/// `fill(i, part, piece)` writes part `i`'s piece of `len(part)` entries (`blank` until then),
+/// every part in parallel. Allocated once at its final size.
+fn side_by_side<T: Copy + Send>(
+    parts: &[Part],
+    (blank, closing): (T, Option<T>),
+    len: impl Fn(&Part) -> usize,
+    fill: impl Fn(usize, &Part, &mut [T]) + Sync,
+) -> Vec<T> {
+    let pieces_len: usize = parts.iter().map(&len).sum();
+    let mut out = vec![blank; pieces_len + usize::from(closing.is_some())];
+    if let Some(last) = closing {
+        out[pieces_len] = last;
+    }
+    let mut rest = &mut out[..];
+    let mut pieces = Vec::with_capacity(parts.len());
+    for p in parts {
+        let (piece, after) = rest.split_at_mut(len(p));
+        pieces.push(piece);
+        rest = after;
+    }
+    pieces
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(i, piece)| fill(i, &parts[i], piece));
+    out
+}
+
+/// The end points of a side, smaller first.
+fn ordered(a: VertId, b: VertId) -> (VertId, VertId) {
+    (a.min(b), a.max(b))
+}
+
+/// The sides whose smaller end point lies in one range of vertices, grouped into edges.
+struct Part {
+    /// `(larger end point << 32) | use` per side, by smaller end point, then larger, then use.
+    sides: Vec<u64>,
+    /// Per edge of the range: its end points.
+    edge_verts: Vec<[VertId; 2]>,
+    /// Per edge of the range: where its uses start in `sides`.
+    use_start: Vec<u32>,
+    /// Per vertex of the range: its first edge (edges of vertex `v` are up to the next vertex's).
+    first_edge: Vec<u32>,
+}
+
+impl Part {
+    fn of(tri_verts: &[[VertId; 3]], range: Range<usize>) -> Part {
+        let n = range.len();
+        let local = |t: usize, k: usize| {
+            let v = tri_verts[t];
+            let (a, b) = ordered(v[(k + 1) % 3], v[(k + 2) % 3]);
+            let i = (a.0 as usize).wrapping_sub(range.start);
+            (i < n).then_some((i, b))
+        };
+        // Bucket ends by smaller end point, then filled backwards: `start[i]` ends as the
+        // start of vertex i's bucket, `start[n]` as the count.
+        let mut start = vec![0u32; n + 1];
+        for t in 0..tri_verts.len() {
+            for k in 0..3 {
+                if let Some((i, _)) = local(t, k) {
+                    start[i] += 1;
+                }
+            }
+        }
+        let mut sum = 0;
+        for x in &mut start[..n] {
+            sum += *x;
+            *x = sum;
+        }
+        start[n] = sum;
+        let mut sides = vec![0u64; sum as usize];
+        for t in 0..tri_verts.len() {
+            for k in 0..3 {
+                if let Some((i, b)) = local(t, k) {
+                    start[i] -= 1;
+                    sides[start[i] as usize] = (u64::from(b.0) << 32) | (3 * t + k) as u64;
+                }
+            }
+        }
+        let mut edge_verts = Vec::new();
+        let mut use_start = Vec::new();
+        let mut first_edge = Vec::with_capacity(n);
+        for i in 0..n {
+            first_edge.push(edge_verts.len() as u32);
+            let (from, to) = (start[i] as usize, start[i + 1] as usize);
+            let bucket = &mut sides[from..to];
+            bucket.sort_unstable();
+            for (j, &x) in bucket.iter().enumerate() {
+                if j == 0 || x >> 32 != bucket[j - 1] >> 32 {
+                    edge_verts.push([VertId((range.start + i) as u32), VertId((x >> 32) as u32)]);
+                    use_start.push((from + j) as u32);
+                }
+            }
+        }
+        Part {
+            sides,
+            edge_verts,
+            use_start,
+            first_edge,
+        }
     }
 }
 
@@ -742,6 +881,62 @@ pub(crate) mod tests {
                     assert_eq!(n.slots[2], other.corner());
                 }
             }
+        }
+    }
+
+    #[test]
+    fn the_edges_do_not_depend_on_how_the_vertices_are_cut_for_threads() {
+        // Enough sides to be cut into ranges, on few vertices (crowded edges in every range)
+        // and on many (a subdivided sphere).
+        let odd = odd_mesh(3, PARALLEL_SIDES / 2);
+        let (welded, edges) = reference(&odd);
+        let mut sphere = TriMesh::default();
+        let n = 120u32;
+        for i in 0..=n {
+            for j in 0..n {
+                let (u, v) = (
+                    f64::from(i) * std::f64::consts::PI / f64::from(n),
+                    f64::from(j) * std::f64::consts::TAU / f64::from(n),
+                );
+                sphere
+                    .positions
+                    .push(DVec3::new(u.sin() * v.cos(), u.sin() * v.sin(), u.cos()));
+                if i < n {
+                    let at = |a: u32, b: u32| a * n + b % n;
+                    sphere
+                        .triangles
+                        .push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                    sphere
+                        .triangles
+                        .push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        }
+        sphere.normals = vec![DVec3::Z; sphere.positions.len()];
+        assert!(3 * sphere.triangles.len() > PARALLEL_SIDES);
+        let in_pool = |threads: usize, mesh: &TriMesh| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| Topology::build(mesh))
+        };
+        let one = in_pool(1, &odd);
+        assert_eq!(one.welded_of_vertex, welded);
+        assert_eq!(one.edge_count(), edges.len());
+        for (e, (verts, uses)) in edges.iter().enumerate() {
+            let edge = one.edge(EdgeId(e as u32));
+            assert_eq!((edge.verts, edge.tris), (*verts, uses.as_slice()));
+            for u in uses {
+                assert_eq!(one.tri_edges[u.at().0][u.at().1], EdgeId(e as u32));
+            }
+        }
+        for threads in [2, 3, 8] {
+            assert_eq!(in_pool(threads, &odd), one, "{threads} threads");
+        }
+        let one = in_pool(1, &sphere);
+        for threads in [2, 3, 5] {
+            assert_eq!(in_pool(threads, &sphere), one, "{threads} threads");
         }
     }
 

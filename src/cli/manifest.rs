@@ -26,11 +26,13 @@ const FORMAT: u32 = 1;
 /// What an output was made from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Fingerprint {
-    /// Hash of the asset, its buffer and image files, and its sidecar (or their absence).
+    /// Hash of the asset, its buffer and image files, and its sidecar (or their absence);
+    /// empty for a job without a manifest, where nothing reads it.
     pub inputs: String,
     /// Hash of the tool's version and the effective options.
     pub settings: String,
-    /// Every file hashed into `inputs`, as the asset's path names them (for watching).
+    /// Every file the input consists of (hashed into `inputs` where there is a manifest), as
+    /// the asset's path names them (for watching).
     pub files: Vec<PathBuf>,
     /// Each of `files`' size and time just before it was read (`None`: absent).
     pub stamps: Vec<Option<Stamp>>,
@@ -45,12 +47,21 @@ impl Fingerprint {
     ///
     /// Each file's [`Stamp`] is taken before it is read, so that a change made while the job
     /// runs shows as a change afterwards.
+    ///
+    /// The contents are read only for a job that has a manifest, the one reader of the hash:
+    /// a named output file or an output beside its input would otherwise read its whole input
+    /// a second time on every run (28 MB for a million triangles) for nothing. Such a job's
+    /// `inputs` is empty; its files and stamps (which `--watch` reads) are taken all the same.
     pub fn of(job: &Job, options: &Options) -> Fingerprint {
         let files = pipeline::files_read(&job.input, options);
         let mut stamps = Vec::with_capacity(files.len());
         let mut h = fnv::FnvHasher::default();
+        let hashed = job.manifest_dir.is_some();
         for file in &files {
             stamps.push(Stamp::of(file));
+            if !hashed {
+                continue;
+            }
             h.write(file.file_name().unwrap_or_default().as_encoded_bytes());
             match std::fs::read(file).ok().map(|b| hash(&b)) {
                 Some(c) => h.write_u64(c),
@@ -63,7 +74,11 @@ impl Fingerprint {
         output_settings.report_figures = false;
         let settings = format!("{} {output_settings:?}", env!("CARGO_PKG_VERSION"));
         Fingerprint {
-            inputs: format!("{:016x}", h.finish()),
+            inputs: if hashed {
+                format!("{:016x}", h.finish())
+            } else {
+                String::new()
+            },
             settings: format!("{:016x}", hash(settings.as_bytes())),
             files,
             stamps,
@@ -231,6 +246,32 @@ pub fn written_files(output: &Path) -> Vec<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_a_job_with_a_manifest_reads_its_input_for_the_hash() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("a.glb");
+        std::fs::write(&input, b"not read without a manifest").unwrap();
+        let mut job = Job {
+            input: input.clone(),
+            output: dir.path().join("out/a.glb"),
+            config_root: dir.path().into(),
+            manifest_dir: None,
+            key: "a.glb".into(),
+        };
+        let options = Options::default();
+        let plain = Fingerprint::of(&job, &options);
+        assert_eq!(plain.inputs, "");
+        // The watcher's stamps are taken either way.
+        assert_eq!(plain.files[0], input);
+        assert_eq!(plain.stamps[0], Stamp::of(&input));
+
+        job.manifest_dir = Some(dir.path().join("out"));
+        let before = Fingerprint::of(&job, &options).inputs;
+        assert_eq!(before.len(), 16);
+        std::fs::write(&input, b"same size, other bytes!!!!!!").unwrap();
+        assert_ne!(Fingerprint::of(&job, &options).inputs, before);
+    }
 
     #[test]
     fn the_hash_is_fnv1a_64() {

@@ -212,6 +212,17 @@ impl Tally {
         self.count += 1;
     }
 
+    /// Counts `i`, keeping it as an example if it is among the smallest seen, in any order.
+    fn insert(&mut self, i: usize) {
+        let kept = self.count.min(EXAMPLES);
+        let at = self.first[..kept].partition_point(|&x| x < i);
+        if at < EXAMPLES {
+            self.first.copy_within(at..EXAMPLES - 1, at + 1);
+            self.first[at] = i;
+        }
+        self.count += 1;
+    }
+
     fn examples(&self) -> &[usize] {
         &self.first[..self.count.min(EXAMPLES)]
     }
@@ -229,33 +240,57 @@ fn largest_angle_cosine(p: [DVec3; 3]) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
-/// Triangles with the same three welded corners as an earlier triangle (in any order). Sorting
-/// the corner triples groups the copies: no hash map over every triangle, and near-linear
-/// however many copies one triangle has.
+/// Edges with more uses than this have their triangles sorted to find copies; on the others a
+/// triangle looks among the few triangles on its edge.
+const CROWDED: usize = 8;
+
+/// Triangles with the same three welded corners as an earlier triangle (in any order).
+///
+/// A copy has every edge of its original, so each triangle looks for an earlier one with its
+/// corners among the uses of one edge chosen by the corners alone (between its two smallest
+/// vertex ids, so that every copy picks the same edge): on a manifold mesh that is one other
+/// triangle, with no array over every triangle. The triangles of crowded edges (books, many
+/// copies of one triangle) are sorted by their corners instead, so that no shape makes this
+/// worse than a sort.
 fn duplicate_triangles(topo: &Topology) -> Tally {
-    let mut keyed: Vec<([u32; 3], u32)> = topo
-        .tri_verts
-        .par_iter()
-        .enumerate()
-        .filter_map(|(t, v)| {
-            let mut key = v.map(|x| x.0);
-            key.sort_unstable();
-            (key[0] != key[1] && key[1] != key[2]).then_some((key, t as u32))
+    let corners = |t: usize| {
+        let mut key = topo.tri_verts[t].map(|x| x.0);
+        key.sort_unstable();
+        key
+    };
+    // The uses of the edge between the two smallest corners (opposite the largest), or `None`
+    // for a triangle with a repeated corner, which is degenerate rather than a copy.
+    let chosen = |t: usize, key: &[u32; 3]| {
+        if key[0] == key[1] || key[1] == key[2] {
+            return None;
+        }
+        let v = topo.tri_verts[t];
+        let largest = v.iter().position(|x| x.0 == key[2]).unwrap_or(0);
+        Some(topo.edge_uses(topo.tri_edges[t][largest]))
+    };
+    let mut found = Tally::of(topo.tri_verts.len(), |t| {
+        let key = corners(t);
+        chosen(t, &key).is_some_and(|uses| {
+            uses.len() <= CROWDED
+                && uses
+                    .iter()
+                    .take_while(|u| (u.tri().0 as usize) < t)
+                    .any(|u| corners(u.tri().0 as usize) == key)
+        })
+    });
+    let mut crowded: Vec<([u32; 3], u32)> = (0..topo.tri_verts.len())
+        .into_par_iter()
+        .filter_map(|t| {
+            let key = corners(t);
+            let uses = chosen(t, &key)?;
+            (uses.len() > CROWDED).then_some((key, t as u32))
         })
         .collect();
     // Entries are distinct (the triangle index differs), so the order is the one there is.
-    keyed.par_sort_unstable();
-    // Every entry after the first of its group is a copy; the smallest copies are the examples.
-    let mut found = Tally::default();
-    for w in keyed.windows(2).filter(|w| w[0].0 == w[1].0) {
-        let t = w[1].1 as usize;
-        let kept = found.count.min(EXAMPLES);
-        let at = found.first[..kept].partition_point(|&x| x < t);
-        if at < EXAMPLES {
-            found.first.copy_within(at..EXAMPLES - 1, at + 1);
-            found.first[at] = t;
-        }
-        found.count += 1;
+    crowded.par_sort_unstable();
+    // Every entry after the first of its group is a copy.
+    for w in crowded.windows(2).filter(|w| w[0].0 == w[1].0) {
+        found.insert(w[1].1 as usize);
     }
     found
 }

@@ -60,10 +60,18 @@ impl CreaseTest {
     /// edge, including all near the threshold, takes the exact path, so the result is the same.
     pub fn dihedral_if_crease(&self, edge: &Edge<'_>, topo: &Topology) -> Option<f64> {
         let (n0, n1) = oriented_normals(edge, topo)?;
-        let (sin, cos) = (n0.cross(n1).length(), n0.dot(n1));
-        let radius = (sin * sin + cos * cos).sqrt();
-        // NaN, overflowing and underflowing sizes fail the test and take the exact path.
-        if radius.is_finite() && radius > 1e-140 && cos / radius > self.clear_cosine {
+        // cos / radius > clear, compared in squares: no square root or division per edge,
+        // and rounding far inside the 1e-9 margin.
+        let (cos, clear) = (n0.dot(n1), self.clear_cosine);
+        let radius2 = n0.cross(n1).length_squared() + cos * cos;
+        let clear_of_it = if clear >= 0.0 {
+            cos > 0.0 && cos * cos > clear * clear * radius2
+        } else {
+            cos >= 0.0 || cos * cos < clear * clear * radius2
+        };
+        // NaN, overflowing and underflowing sizes fail the test and take the exact path, as
+        // does a NaN threshold.
+        if radius2.is_finite() && radius2 > 1e-280 && !clear.is_nan() && clear_of_it {
             return None;
         }
         let dihedral = angle_degrees(n0, n1);
