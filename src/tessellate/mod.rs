@@ -32,7 +32,7 @@
 //! output (no array of edge samples in between; a triangle that owns a split copy of them
 //! evaluates the edge's evaluating side once more for the positions and its own side for the
 //! normals), and each triangle evaluates only its interior
-//! ([`LatticePart`](crate::surface::LatticePart)). A triangle asks for the edges it owns and its
+//! ([`LatticePart`]). A triangle asks for the edges it owns and its
 //! interior in one call ([`Surface::evaluate_lattice_parts`]), so that the surface rebuilds the
 //! triangle's net once and composes each neighbour's net once for all of them (on the 100k
 //! icosphere, 13% fewer instructions in evaluation at level 3, 3% at level 2; on the 10k
