@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::blend::neighbour_map;
 use super::nets::Nets;
-use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights};
+use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights, LANES};
 use super::pn::{compose, Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
@@ -512,10 +512,64 @@ impl Surface for G2Surface {
         part: LatticePart,
         out: &mut Vec<SurfacePoint>,
     ) {
-        let patch = &self.patches[tri];
-        let local = self.local(tri);
-        self.patterns
-            .with(level, part, patch.widths, self.profile, |pattern| {
+        PartEvaluation::new(self, tri).part(level, part, out);
+    }
+
+    /// [`Surface::evaluate_lattice_part`] part after part, with the triangle's own net rebuilt
+    /// and broadcast once, and each neighbour's net composed (Eq. 3) once for every part that
+    /// blends across its edge (an edge and the interior both do), instead of once per part.
+    fn evaluate_lattice_parts(
+        &self,
+        tri: usize,
+        parts: &[(u32, LatticePart)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let mut evaluation = PartEvaluation::new(self, tri);
+        for &(level, part) in parts {
+            evaluation.part(level, part, out);
+        }
+    }
+}
+
+/// One patch set up for lattice parts: its net rebuilt and broadcast once, and each
+/// neighbour's net composed (Eq. 3) the first time a part blends across that edge, then kept.
+/// The values are those a part evaluated alone computes, so parts evaluated together or apart
+/// agree bit for bit.
+struct PartEvaluation<'a> {
+    surface: &'a G2Surface,
+    patch: &'a Patch,
+    local: Local,
+    own: Broadcast<LANES>,
+    across: [Option<Broadcast<LANES>>; 3],
+}
+
+impl<'a> PartEvaluation<'a> {
+    #[inline]
+    fn new(surface: &'a G2Surface, tri: usize) -> Self {
+        let patch = &surface.patches[tri];
+        let local = surface.local(tri);
+        PartEvaluation {
+            surface,
+            patch,
+            own: broadcast(&local.net),
+            local,
+            across: [None; 3],
+        }
+    }
+
+    /// The points of `part` of the level-`level` lattice, appended to `out`.
+    #[inline]
+    fn part(&mut self, level: u32, part: LatticePart, out: &mut Vec<SurfacePoint>) {
+        let PartEvaluation {
+            surface,
+            patch,
+            local,
+            own,
+            across,
+        } = self;
+        surface
+            .patterns
+            .with(level, part, patch.widths, surface.profile, |pattern| {
                 let base = out.len();
                 out.resize(
                     base + pattern.len,
@@ -531,16 +585,17 @@ impl Surface for G2Surface {
                         normal: local.normal[c as usize],
                     };
                 }
-                let own = broadcast(&local.net);
                 let groups = std::iter::once((None, &pattern.plain))
                     .chain((0..3).map(|k| (Some(k), &pattern.blended[k])));
                 for (k, blocks) in groups {
                     if blocks.is_empty() {
                         continue;
                     }
-                    let across = k.map(|k| broadcast(&self.across_net(patch, k)));
+                    let across = k.map(|k| {
+                        &*across[k].get_or_insert_with(|| broadcast(&surface.across_net(patch, k)))
+                    });
                     for lanes in blocks {
-                        let points = Self::combine(&local.normal, lanes, &own, across.as_ref());
+                        let points = G2Surface::combine(&local.normal, lanes, own, across);
                         for (&target, p) in lanes.target.iter().zip(points) {
                             if target != Lanes::<1>::PADDING {
                                 out[target as usize] = p;
@@ -589,6 +644,15 @@ impl Surface for PnSurface {
         out: &mut Vec<SurfacePoint>,
     ) {
         self.0.evaluate_lattice_part(tri, level, part, out)
+    }
+
+    fn evaluate_lattice_parts(
+        &self,
+        tri: usize,
+        parts: &[(u32, LatticePart)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        self.0.evaluate_lattice_parts(tri, parts, out)
     }
 
     fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {

@@ -116,6 +116,21 @@ pub trait Surface: Sync {
         self.evaluate_lattice_points(tri, level, &part.points(level), out);
     }
 
+    /// The points of several parts `(level, part)` of triangle `tri`'s lattices, appended to
+    /// `out` part after part, each as [`Surface::evaluate_lattice_part`] gives it, bit for bit.
+    /// The tessellator asks for all the parts a triangle writes at once, so that a surface can
+    /// set the triangle up once for all of them.
+    fn evaluate_lattice_parts(
+        &self,
+        tri: usize,
+        parts: &[(u32, LatticePart)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        for &(level, part) in parts {
+            self.evaluate_lattice_part(tri, level, part, out);
+        }
+    }
+
     /// The points at barycentrics `barys` of triangle `tri`, appended to `out` in order; equal to
     /// [`Surface::evaluate`] bit for bit. Many points of one triangle at once let a surface do
     /// its per-triangle work once (the chord error measurement asks for thousands).

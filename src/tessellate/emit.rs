@@ -24,6 +24,11 @@ pub(super) struct TriangleWriter<'a> {
     own_edge: Vec<SurfacePoint>,
     evaluator_edge: Vec<SurfacePoint>,
     interior: Vec<SurfacePoint>,
+    /// The parts [`TriangleWriter::evaluate_parts`] evaluated together, for triangle
+    /// `batch_tri`: their points one part after another, and where each part's run starts.
+    batch: Vec<SurfacePoint>,
+    batch_tri: usize,
+    batch_parts: Vec<(u32, LatticePart, usize)>,
 }
 
 impl<'a> TriangleWriter<'a> {
@@ -40,7 +45,41 @@ impl<'a> TriangleWriter<'a> {
             own_edge: Vec::new(),
             evaluator_edge: Vec::new(),
             interior: Vec::new(),
+            batch: Vec::new(),
+            batch_tri: usize::MAX,
+            batch_parts: Vec::new(),
         }
+    }
+
+    /// Evaluates the parts `(level, part)` of `tri` that the steps of this triangle will write,
+    /// in one call ([`Surface::evaluate_lattice_parts`]): the surface sets the triangle up once
+    /// for all of them instead of once per part. The steps then read them from here; a part not
+    /// named is evaluated by its step, with the same bits.
+    pub fn evaluate_parts(&mut self, tri: usize, parts: &[(u32, LatticePart)]) {
+        self.batch.clear();
+        self.batch_parts.clear();
+        self.batch_tri = tri;
+        self.surface
+            .evaluate_lattice_parts(tri, parts, &mut self.batch);
+        let mut start = 0;
+        for &(level, part) in parts {
+            self.batch_parts.push((level, part, start));
+            start += part_len(level, part);
+        }
+        debug_assert_eq!(start, self.batch.len());
+    }
+
+    /// Where part `(level, part)` of `tri` lies in the batch, if [`TriangleWriter::evaluate_parts`]
+    /// evaluated it.
+    #[inline]
+    fn batched(&self, tri: usize, level: u32, part: LatticePart) -> Option<usize> {
+        if self.batch_tri != tri {
+            return None;
+        }
+        self.batch_parts
+            .iter()
+            .find(|&&(l, p, _)| l == level && p == part)
+            .map(|&(_, _, start)| start)
     }
 
     /// Corner `c` of `tri`, local point `point`, output slot `slot`; written if `owned`.
@@ -94,9 +133,20 @@ impl<'a> TriangleWriter<'a> {
         let forward = canonical_forward(self.topo, tri, k);
         let evaluated_by = evaluator(self.topo, e);
         let evaluated_here = evaluated_by == Some((tri, k));
-        self.own_edge.clear();
-        self.surface
-            .evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut self.own_edge);
+        let own_start = self.batched(tri, n, LatticePart::Edge(k as u8));
+        if own_start.is_none() {
+            self.own_edge.clear();
+            self.surface.evaluate_lattice_part(
+                tri,
+                n,
+                LatticePart::Edge(k as u8),
+                &mut self.own_edge,
+            );
+        }
+        let own_edge = match own_start {
+            Some(start) => &self.batch[start..start + (n - 1) as usize],
+            None => &self.own_edge[..],
+        };
         // The evaluator's run, and whether it is walked the same way as this side's.
         let mut same_direction = true;
         if !evaluated_here {
@@ -112,7 +162,7 @@ impl<'a> TriangleWriter<'a> {
             }
         }
         let positions = if evaluated_here || evaluated_by.is_none() {
-            &self.own_edge
+            own_edge
         } else {
             &self.evaluator_edge
         };
@@ -123,7 +173,7 @@ impl<'a> TriangleWriter<'a> {
             block.put(
                 s,
                 positions[at].position.as_vec3().to_array(),
-                self.own_edge[(m - 1) as usize].normal.as_vec3().to_array(),
+                own_edge[(m - 1) as usize].normal.as_vec3().to_array(),
                 source(p),
             );
         }
@@ -144,13 +194,23 @@ impl<'a> TriangleWriter<'a> {
         by_rank: impl Iterator<Item = (usize, usize)>,
         source: impl Fn(usize) -> VertexSource,
     ) {
-        self.interior.clear();
-        self.surface
-            .evaluate_lattice_part(tri, level, LatticePart::Interior, &mut self.interior);
+        let interior = match self.batched(tri, level, LatticePart::Interior) {
+            Some(start) => &self.batch[start..],
+            None => {
+                self.interior.clear();
+                self.surface.evaluate_lattice_part(
+                    tri,
+                    level,
+                    LatticePart::Interior,
+                    &mut self.interior,
+                );
+                &self.interior[..]
+            }
+        };
         for (rank, (point, index)) in by_rank.enumerate() {
             let slot = first_slot + rank;
             local[point] = slot as u32;
-            let p = &self.interior[index];
+            let p = &interior[index];
             block.put(
                 slot,
                 p.position.as_vec3().to_array(),
@@ -158,6 +218,17 @@ impl<'a> TriangleWriter<'a> {
                 source(point),
             );
         }
+    }
+}
+
+/// Points in `part` of the level-`level` lattice (see [`LatticePart::points`]).
+#[inline]
+fn part_len(level: u32, part: LatticePart) -> usize {
+    let n = level as usize;
+    match part {
+        LatticePart::All => (n + 1) * (n + 2) / 2,
+        LatticePart::Interior => n.saturating_sub(1) * n.saturating_sub(2) / 2,
+        LatticePart::Edge(_) => n.saturating_sub(1),
     }
 }
 

@@ -32,7 +32,11 @@
 //! output (no array of edge samples in between; a triangle that owns a split copy of them
 //! evaluates the edge's evaluating side once more for the positions and its own side for the
 //! normals), and each triangle evaluates only its interior
-//! ([`LatticePart`](crate::surface::LatticePart)). That per-triangle loop is one piece of code
+//! ([`LatticePart`]). A triangle asks for the edges it owns and its
+//! interior in one call ([`Surface::evaluate_lattice_parts`]), so that the surface rebuilds the
+//! triangle's net once and composes each neighbour's net once for all of them (on the 100k
+//! icosphere, 13% fewer instructions in evaluation at level 3, 3% at level 2; on the 10k
+//! icosphere at level 16, 6%). That per-triangle loop is one piece of code
 //! (`emit.rs`) for this uniform path and the per-edge-count path (`adaptive.rs`).
 //! Blocks run in parallel (rayon) and write straight into those ranges: no per-vertex
 //! allocation, no hash map, and the same bytes at any thread count. Triangles come out in
@@ -51,7 +55,7 @@ mod plan;
 mod transition;
 
 use crate::mesh::TriMesh;
-use crate::surface::{lattice_bary, Surface};
+use crate::surface::{lattice_bary, LatticePart, Surface};
 use crate::topology::{EdgeId, Topology};
 use blocks::Block;
 use layout::GroupLayout;
@@ -304,10 +308,24 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
     let per_tri_indices = 3 * (n * n) as usize;
     let mut writer = emit::TriangleWriter::new(mesh, topo, surface);
     let mut local = vec![0u32; plan.len];
+    let mut parts = Vec::with_capacity(4);
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
         let corners = mesh.triangles[tri];
         let owns = layout.owns[offset];
+        // Every part this triangle evaluates, in one call: its owned edges and its interior.
+        parts.clear();
+        parts.extend(
+            (0..3u8)
+                .filter(|&k| owns & (8 << k) != 0)
+                .map(|k| (n, LatticePart::Edge(k))),
+        );
+        if plan.interior > 0 {
+            parts.push((n, LatticePart::Interior));
+        }
+        if !parts.is_empty() {
+            writer.evaluate_parts(tri, &parts);
+        }
         // The level was checked once in `tessellate`, the coordinates come from its plan.
         let source = |li: usize| {
             let [i, j] = plan.lattice_ij[li];

@@ -8,7 +8,9 @@ use g2tess::mesh::TriMesh;
 use g2tess::surface::coons::patch::Definition2;
 use g2tess::surface::coons::{Constituents, CoonsSurface, NormalMethod};
 use g2tess::surface::hybrid::{HybridSurface, PaperReading};
-use g2tess::surface::{lattice_bary, LatticePart, SchemeParams, Surface};
+use g2tess::surface::{
+    lattice_bary, G2Surface, LatticePart, PnSurface, Profile, SchemeParams, Surface,
+};
 use g2tess::topology::Topology;
 
 /// Whole lattices and scattered points of every triangle against `evaluate`, bit for bit.
@@ -119,6 +121,79 @@ fn coons_lattice_equals_evaluate_bit_for_bit() {
                 }
                 let fd = s.clone().with_normals(NormalMethod::FiniteDifference);
                 assert_lattice_is_pointwise(&format!("coons differences {name}"), &fd, n);
+            }
+        }
+    }
+}
+
+/// Several parts of one triangle asked for in one call (as the tessellator asks for a
+/// triangle's owned edges and its interior) against each part asked for alone, bit for bit:
+/// the G² surface sets the triangle up once for all of them and composes each neighbour's net
+/// once for every part that blends across its edge, so a part read with another part's
+/// neighbour, or in another part's slots, shows here.
+#[test]
+fn lattice_parts_together_equal_each_part_alone_bit_for_bit() {
+    let orders: [&[LatticePart]; 4] = [
+        &[
+            LatticePart::Edge(0),
+            LatticePart::Edge(1),
+            LatticePart::Edge(2),
+            LatticePart::Interior,
+        ],
+        &[
+            LatticePart::Interior,
+            LatticePart::Edge(2),
+            LatticePart::Edge(0),
+        ],
+        &[LatticePart::Edge(1), LatticePart::All, LatticePart::Edge(1)],
+        &[LatticePart::Edge(2)],
+    ];
+    for (name, mesh) in meshes() {
+        let topo = Topology::build(&mesh);
+        let h = h_all(&topo, 0.3);
+        let surfaces: Vec<(String, Box<dyn Surface>)> = vec![
+            (
+                "g2 c2".into(),
+                Box::new(G2Surface::new(&mesh, &topo, &h, Profile::C2)),
+            ),
+            (
+                "g2 paper".into(),
+                Box::new(G2Surface::new(&mesh, &topo, &h, Profile::Paper)),
+            ),
+            ("pn".into(), Box::new(PnSurface::new(&mesh, &topo))),
+            (
+                "hybrid".into(),
+                Box::new(HybridSurface::with_reading(
+                    &mesh,
+                    &topo,
+                    &h,
+                    PaperReading::Corrected,
+                )),
+            ),
+        ];
+        for (label, s) in &surfaces {
+            for level in [1, 2, 3, 5, 16] {
+                for t in 0..mesh.triangles.len() {
+                    for (o, order) in orders.iter().enumerate() {
+                        // Mixed levels too, as the per-edge-count path has them.
+                        let parts: Vec<(u32, LatticePart)> = order
+                            .iter()
+                            .enumerate()
+                            .map(|(i, &p)| (if i == 1 { level + 1 } else { level }, p))
+                            .collect();
+                        let mut together = Vec::new();
+                        s.evaluate_lattice_parts(t, &parts, &mut together);
+                        let mut apart = Vec::new();
+                        for &(l, p) in &parts {
+                            s.evaluate_lattice_part(t, l, p, &mut apart);
+                        }
+                        assert!(!apart.is_empty() || level == 1);
+                        assert_eq!(
+                            together, apart,
+                            "{label} {name}: triangle {t} level {level} order {o}"
+                        );
+                    }
+                }
             }
         }
     }
