@@ -37,9 +37,11 @@ pub struct AdaptiveFigures {
     pub chord_error: Option<f64>,
     /// The largest segment count of any edge or interior.
     pub max_segments: u32,
-    /// The smallest angle of any output triangle, in degrees.
+    /// The smallest angle of any output triangle, in degrees, when the report computes
+    /// figures (else 180).
     pub min_angle_degrees: f64,
-    /// The largest ratio of longest edge to shortest altitude × 2/√3 (1 for equilateral).
+    /// The largest ratio of longest edge to shortest altitude × 2/√3 (1 for equilateral), when
+    /// the report computes figures (else 1).
     pub max_aspect_ratio: f64,
 }
 
@@ -126,8 +128,9 @@ impl Density {
             Density::Level(level) if measure => (SegmentCounts::uniform(topo, *level), None),
             Density::Level(_) => return None,
         };
+        // Only a report shows them, and they take a pass over every output triangle.
         let (mut min_angle, mut max_aspect) = (180.0f64, 1.0f64);
-        for d in dense {
+        for d in dense.iter().filter(|_| measure) {
             let (a, r) = shape(d);
             min_angle = min_angle.min(a);
             max_aspect = max_aspect.max(r);

@@ -38,6 +38,15 @@ pub(crate) struct Curvature {
     at: Vec<[f64; 3]>,
 }
 
+/// The interior point of the level-`l` lattice nearest barycentrics `b`, as an index among the
+/// interior points in lattice order.
+fn nearest(l: u32, b: [f64; 3]) -> usize {
+    let round = |x: f64| (x * f64::from(l)).round().max(1.0) as u32;
+    let i = round(b[1]).min(l - 2);
+    let j = round(b[2]).min(l - 1 - i);
+    interior_index(l, i, j)
+}
+
 /// Index of interior point `(i, j)` of the level-`n` lattice among the interior points, in
 /// lattice order.
 fn interior_index(n: u32, i: u32, j: u32) -> usize {
@@ -65,15 +74,6 @@ impl Curvature {
                 ]);
             }
         }
-    }
-
-    /// The interior point nearest barycentrics `b`.
-    fn nearest(&self, b: [f64; 3]) -> usize {
-        let l = self.level;
-        let round = |x: f64| (x * f64::from(l)).round().max(1.0) as u32;
-        let i = round(b[1]).min(l - 2);
-        let j = round(b[2]).min(l - 1 - i);
-        interior_index(l, i, j)
     }
 
     /// The largest predicted error of the inner lattice of a level-`m` pattern (every triangle
@@ -104,19 +104,14 @@ impl Curvature {
         scale * worst
     }
 
-    /// The predicted error of one output triangle of `model`, at the second differences of
-    /// the interior points nearest its corners.
+    /// The predicted error of one output triangle of a model, at the second differences of
+    /// the interior points nearest its corners (found when the model was built).
     fn triangle_error(&self, t: &ModelTriangle) -> f64 {
+        debug_assert_eq!(t.level, self.level, "the model was built for this lattice");
         let l2 = f64::from(self.level).powi(2);
         let mut worst = 0.0f64;
-        let mut seen = [usize::MAX; 3];
-        for (c, b) in t.corners.iter().enumerate() {
-            let p = self.nearest(*b);
-            if seen[..c].contains(&p) {
-                continue;
-            }
-            seen[c] = p;
-            let [d1, d2, d3] = self.at[p];
+        for &p in t.nearest.iter().filter(|&&p| p != u32::MAX) {
+            let [d1, d2, d3] = self.at[p as usize];
             let mixed = d1 + d2 - d3;
             let q = t
                 .edges
@@ -139,8 +134,11 @@ fn worst_abs(q: [f64; 3]) -> f64 {
 /// An output triangle of a pattern that touches the source triangle's boundary.
 #[derive(Debug, Clone)]
 struct ModelTriangle {
-    /// Barycentrics of its corners.
-    corners: [[f64; 3]; 3],
+    /// The lattice level the model reads.
+    level: u32,
+    /// The interior points of that lattice nearest its corners, each once (`u32::MAX` for a
+    /// repeat): where its second differences are read.
+    nearest: [u32; 3],
     /// For its edges (corners 0–1, 1–2, 0–2) with domain vector `(d_i, d_j)`: `(d_i², d_j², d_i d_j)`.
     edges: [[f64; 3]; 3],
     /// The source triangle's edges it touches (bit `k`: edge `k`).
@@ -165,7 +163,9 @@ pub(crate) struct PatternError {
 }
 
 impl PatternModel {
-    pub fn new(pattern: &Pattern) -> PatternModel {
+    /// The model of `pattern` over the second differences of a level-`level` lattice (`level`
+    /// at least 3 and at least the pattern's inner level).
+    pub fn new(pattern: &Pattern, level: u32) -> PatternModel {
         let boundary = (0..pattern.triangles.len())
             .filter_map(|t| {
                 let touches = pattern.touches(t);
@@ -177,8 +177,15 @@ impl PatternModel {
                     let (di, dj) = (corners[a][1] - corners[b][1], corners[a][2] - corners[b][2]);
                     [di * di, dj * dj, di * dj]
                 };
+                let mut nearest = corners.map(|b| nearest(level, b) as u32);
+                for c in 1..3 {
+                    if nearest[..c].contains(&nearest[c]) {
+                        nearest[c] = u32::MAX;
+                    }
+                }
                 Some(ModelTriangle {
-                    corners,
+                    level,
+                    nearest,
                     edges: [edge(0, 1), edge(1, 2), edge(0, 2)],
                     touches,
                 })
