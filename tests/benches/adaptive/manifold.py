@@ -12,7 +12,7 @@ triangle (centroid, edge midpoints, halfway to each corner) from the sphere or t
 Manifold tolerance whose output is as close to the shape as g2tess's is found by bisection
 (Manifold's tolerance bounds the deviation of its edge curves only, not of triangle interiors).
 
-Usage: manifold.py [--bin target/release/g2tess] [--eps 1e-3,1e-4] sphere.glb torus.glb
+Usage: manifold.py [--bin target/release/g2tess] [--eps 1e-3,3e-4,1e-4] sphere.glb torus.glb
 """
 import argparse, json, os, struct, subprocess, sys, tempfile
 
@@ -91,7 +91,7 @@ def manifold(pos, nrm, tris, eps):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", default="target/release/g2tess")
-    ap.add_argument("--eps", default="1e-3,1e-4")
+    ap.add_argument("--eps", default="1e-3,3e-4,1e-4")
     ap.add_argument("meshes", nargs="+")
     a = ap.parse_args()
     print("| mesh | ε | g2tess adaptive tris | its chord error | its shape error "
