@@ -231,7 +231,7 @@ pub fn smooth_mesh(
     // Every level written is held (and, with MSFT_lod, stored in the one file): the limit is
     // on their sum.
     let mut planned_total = 0u64;
-    // The G² surface holds about 160 bytes per input triangle: freed once the last level is
+    // The G² surface holds about 112 bytes per input triangle: freed once the last level is
     // tessellated, before its attributes are carried, when the dense mesh is at its largest.
     let mut surface = Some(surface);
     let last = levels.len() - 1;
@@ -401,12 +401,12 @@ fn lap(clock: &Instant, before: f64) -> f64 {
 }
 
 /// The surface the options ask for, with the warnings its construction gave.
-pub(super) fn build_surface(
+pub(super) fn build_surface<'a>(
     options: &Options,
-    mesh: &TriMesh,
-    topo: &Topology,
+    mesh: &'a TriMesh,
+    topo: &'a Topology,
     h: &EffectiveH,
-) -> (Box<dyn Surface>, Vec<scheme::Warning>) {
+) -> (Box<dyn Surface + 'a>, Vec<scheme::Warning>) {
     let params = options.scheme_params();
     scheme::build_surface(options.scheme, mesh, topo, h, &params)
 }
