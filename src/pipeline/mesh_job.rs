@@ -405,7 +405,7 @@ pub(super) fn build_surface<'a>(
     options: &Options,
     mesh: &'a TriMesh,
     topo: &'a Topology,
-    h: &EffectiveH,
+    h: &'a EffectiveH,
 ) -> (Box<dyn Surface + 'a>, Vec<scheme::Warning>) {
     let params = options.scheme_params();
     scheme::build_surface(options.scheme, mesh, topo, h, &params)

@@ -22,10 +22,10 @@ use crate::topology::{Edge, EdgeId, Topology, TriId};
 type SoaNet = [[f64; 10]; 3];
 
 /// Everything one triangle needs at evaluation time that the mesh and its topology do not
-/// already hold: 112 bytes, one allocation for the whole mesh.
+/// already hold: 88 bytes, one allocation for the whole mesh.
 ///
-/// The corners' positions and normals are read from the mesh the surface borrows, and the
-/// neighbours from its topology, not copied: every rule of [`Nets`] copies a corner's position
+/// The corners' positions and normals are read from the mesh the surface borrows, the
+/// neighbours and edge widths through its topology, not copied: every rule of [`Nets`] copies a corner's position
 /// into its net bit for bit and the shared edge curves leave corners alone, so the net is whole
 /// again when a lattice part asks for it ([`G2Surface::local`]). Both outlive the surface in
 /// the pipeline anyway (the tessellation reads them), so a copy here would only add to the
@@ -43,9 +43,6 @@ struct Patch {
     /// compute the same flat point from the same two corners, so a curve they share is still
     /// shared bit for bit, and the surface stays watertight exactly as with `f64` points.
     inner: [[f32; INNER]; 3],
-    /// The effective width of the edge opposite each corner: kept here rather than read through
-    /// an edge index, so the surface needs no copy of the per-edge widths.
-    widths: [f64; 3],
     /// Bit `m − 3` set: edge point `m` is an average of split-normal curves (PN-AEN), used as
     /// stored. Every other edge point lies in its corner's tangent plane (both net rules put it
     /// there), and is put back into it exactly when the net is rebuilt ([`local`]): the `f32`
@@ -57,7 +54,7 @@ struct Patch {
 
 /// The bytes a [`Patch`] takes: pinned, since the surface's memory per triangle is a figure the
 /// pipeline is planned around (the run's peak at a million triangles).
-const _: () = assert!(std::mem::size_of::<Patch>() == 112);
+const _: () = assert!(std::mem::size_of::<Patch>() == 88);
 
 /// Control points of a net that are not corners (the corners are slots 0, 1, 2).
 const INNER: usize = 7;
@@ -123,12 +120,15 @@ struct Local {
 
 /// The G² blended surface of Lee–Hwang–Yoon over a whole mesh, one width `h` per welded edge.
 ///
-/// It borrows the mesh (corner positions and normals) and its topology (the neighbour across
-/// each blended edge) instead of copying them; see [`Patch`].
+/// It borrows the mesh (corner positions and normals), its topology (each triangle's edges, and
+/// the neighbour across each blended edge) and the widths instead of copying them; see
+/// [`Patch`].
 #[derive(Debug)]
 pub struct G2Surface<'a> {
     mesh: &'a TriMesh,
     topo: &'a Topology,
+    /// One width per welded edge; `None`: 0 on every edge (PN triangles).
+    h: Option<&'a [f64]>,
     patches: Vec<Patch>,
     profile: Profile,
     patterns: PatternCache,
@@ -143,7 +143,7 @@ impl<'a> G2Surface<'a> {
     ///
     /// # Panics
     /// If `h`, `topo` and `mesh` do not belong together (a caller bug).
-    pub fn new(mesh: &'a TriMesh, topo: &'a Topology, h: &EffectiveH, profile: Profile) -> Self {
+    pub fn new(mesh: &'a TriMesh, topo: &'a Topology, h: &'a EffectiveH, profile: Profile) -> Self {
         Self::with_nets(mesh, topo, h, profile, Nets::default())
     }
 
@@ -154,36 +154,54 @@ impl<'a> G2Surface<'a> {
     pub fn with_nets(
         mesh: &'a TriMesh,
         topo: &'a Topology,
-        h: &EffectiveH,
+        h: &'a EffectiveH,
         profile: Profile,
         nets_rule: Nets,
     ) -> Self {
-        super::assert_belong_together(mesh, topo, h);
+        super::assert_belong_together(mesh, topo, Some(h));
+        Self::build(mesh, topo, Some(h), profile, nets_rule)
+    }
 
+    /// [`G2Surface::with_nets`] with the widths checked; `h`: `None` for 0 on every edge.
+    fn build(
+        mesh: &'a TriMesh,
+        topo: &'a Topology,
+        h: Option<&'a [f64]>,
+        profile: Profile,
+        nets_rule: Nets,
+    ) -> Self {
         // Built in place, in the final array, in one pass: no per-triangle corner or net arrays
         // beside it.
-        let mut patches: Vec<Patch> = (0..mesh.triangles.len())
+        let patches: Vec<Patch> = (0..mesh.triangles.len())
             .into_par_iter()
             .map(|t| {
                 let (position, normal) = corners(mesh, mesh.triangles[t]);
-                let widths = topo.tri_edges[t].map(|e| h[e.0 as usize]);
-                debug_assert!((0..3)
-                    .all(|k| widths[k] == 0.0 || topo.neighbour(TriId(t as u32), k).is_some()));
                 Patch {
                     inner: offsets(&nets_rule.net(position, normal)),
-                    widths,
                     as_stored: 0,
                 }
             })
             .collect();
-        share_unblended_edge_curves(mesh, topo, h, &mut patches, nets_rule);
-
-        G2Surface {
+        let mut surface = G2Surface {
             mesh,
             topo,
+            h,
             patches,
             profile,
             patterns: PatternCache::default(),
+        };
+        debug_assert!((0..mesh.triangles.len()).all(|t| (0..3)
+            .all(|k| surface.widths(t)[k] == 0.0 || topo.neighbour(TriId(t as u32), k).is_some())));
+        share_unblended_edge_curves(mesh, topo, h, &mut surface.patches, nets_rule);
+        surface
+    }
+
+    /// The effective widths of the edges opposite triangle `tri`'s corners.
+    #[inline]
+    fn widths(&self, tri: usize) -> [f64; 3] {
+        match self.h {
+            Some(h) => self.topo.tri_edges[tri].map(|e| h[e.0 as usize]),
+            None => [0.0; 3],
         }
     }
 
@@ -203,7 +221,7 @@ impl<'a> G2Surface<'a> {
     /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
     /// still agree bit for bit.
     fn across_net(&self, tri: usize, k: usize) -> SoaNet {
-        debug_assert!(self.patches[tri].widths[k] > 0.0, "only blended edges");
+        debug_assert!(self.widths(tri)[k] > 0.0, "only blended edges");
         let n = self
             .topo
             .neighbour(TriId(tri as u32), k)
@@ -424,7 +442,7 @@ impl PointEvaluation {
         let local = surface.local(tri);
         PointEvaluation {
             tri,
-            widths: surface.patches[tri].widths,
+            widths: surface.widths(tri),
             own: broadcast(&local.net),
             local,
             across: [None; 3],
@@ -470,10 +488,9 @@ impl Surface for G2Surface<'_> {
         part: LatticePart,
         out: &mut Vec<SurfacePoint>,
     ) {
-        let patch = &self.patches[tri];
         let local = self.local(tri);
         self.patterns
-            .with(level, part, patch.widths, self.profile, |pattern| {
+            .with(level, part, self.widths(tri), self.profile, |pattern| {
                 let base = out.len();
                 out.resize(
                     base + pattern.len,
@@ -524,13 +541,9 @@ impl<'a> PnSurface<'a> {
     /// PN triangles over `mesh` on nets made by the rule `nets` ([`Nets::Paper`]: Vlachos et
     /// al. as published).
     pub fn with_nets(mesh: &'a TriMesh, topo: &'a Topology, nets: Nets) -> Self {
-        PnSurface(G2Surface::with_nets(
-            mesh,
-            topo,
-            &EffectiveH::zero(topo),
-            Profile::default(),
-            nets,
-        ))
+        // No width table: every edge is at 0.
+        super::assert_belong_together(mesh, topo, None);
+        PnSurface(G2Surface::build(mesh, topo, None, Profile::default(), nets))
     }
 }
 
@@ -565,7 +578,7 @@ impl Surface for PnSurface<'_> {
 fn share_unblended_edge_curves(
     mesh: &TriMesh,
     topo: &Topology,
-    h_edge: &[f64],
+    h_edge: Option<&[f64]>,
     patches: &mut [Patch],
     rule: Nets,
 ) {
@@ -574,10 +587,10 @@ fn share_unblended_edge_curves(
     let uses = |edge| edge_uses(topo, edge);
     let averaged: Vec<(usize, [DVec3; 2])> = topo
         .par_edges()
-        .zip(h_edge.par_iter())
         .enumerate()
-        .filter_map(|(e, (edge, &h))| {
-            if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
+        .filter_map(|(e, edge)| {
+            let blended = h_edge.is_some_and(|h| h[e] > 0.0);
+            if blended || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
                 return None;
             }
             let mut all = uses(edge);

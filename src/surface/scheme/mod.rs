@@ -164,7 +164,7 @@ pub fn build_surface<'a>(
     scheme: Scheme,
     mesh: &'a TriMesh,
     topo: &'a Topology,
-    h_per_edge: &EffectiveH,
+    h_per_edge: &'a EffectiveH,
     params: &SchemeParams,
 ) -> (Box<dyn Surface + 'a>, Vec<Warning>) {
     match scheme {
