@@ -310,14 +310,20 @@ pub fn smooth_mesh(
             if k == 0 {
                 report.primitives.push(PrimitiveReport {
                     primitive: input.primitives[j].index,
-                    triangles_in: prep.triangles.len(),
+                    triangles_in: groups[j].len(),
                     vertices_in: prep.source_vertex_count,
                     triangles_out: d.indices.len() / 3,
                     vertices_out: d.positions.len(),
                     cache: options.report_figures.then(|| optimize::cache_figures(&d)),
                 });
             }
-            let data = primitive_out::build(prep, d, groups[j].start as u32, target);
+            let data = primitive_out::build(
+                prep,
+                d,
+                &mesh.triangles[groups[j].clone()],
+                groups[j].start as u32,
+                target,
+            );
             refuse_non_finite(&data, input.mesh, input.primitives[j].index, options)
                 .map_err(|e| Error::gltf(asset, e))?;
             level_primitives.push((input.primitives[j].index, data));
@@ -560,22 +566,28 @@ fn repair_normals(
 
 /// The primitives of one mesh as one [`TriMesh`], and each primitive's triangle range in it.
 fn join(prepared: &mut [Prepared]) -> (TriMesh, Vec<Range<usize>>) {
-    // Positions and normals move into the joined mesh (nothing reads them from the primitives
-    // afterwards): a lone primitive's are taken whole, several are copied into arrays sized
-    // once and freed one by one, so no copy outlives the join.
+    // Positions, normals and triangles move into the joined mesh (nothing reads them from the
+    // primitives afterwards; the attributes are carried through the mesh's triangles): a lone
+    // primitive's are taken whole, several are copied into arrays sized once and freed one by
+    // one, so no copy outlives the join.
+    if let [p] = prepared {
+        // Its vertex offset is 0: its triangles are the mesh's as they are.
+        let mesh = TriMesh {
+            positions: std::mem::take(&mut p.positions),
+            normals: std::mem::take(&mut p.normals),
+            triangles: std::mem::take(&mut p.triangles),
+        };
+        let all = 0..mesh.triangles.len();
+        return (mesh, vec![all]);
+    }
     let vertices: usize = prepared.iter().map(|p| p.positions.len()).sum();
     let triangles: usize = prepared.iter().map(|p| p.triangles.len()).sum();
     let mut mesh = TriMesh {
         triangles: Vec::with_capacity(triangles),
         ..TriMesh::default()
     };
-    if let [p] = prepared {
-        mesh.positions = std::mem::take(&mut p.positions);
-        mesh.normals = std::mem::take(&mut p.normals);
-    } else {
-        mesh.positions.reserve_exact(vertices);
-        mesh.normals.reserve_exact(vertices);
-    }
+    mesh.positions.reserve_exact(vertices);
+    mesh.normals.reserve_exact(vertices);
     let mut groups = Vec::with_capacity(prepared.len());
     for p in prepared {
         let offset = p.vertex_offset;
@@ -589,6 +601,7 @@ fn join(prepared: &mut [Prepared]) -> (TriMesh, Vec<Range<usize>>) {
         let start = mesh.triangles.len();
         mesh.triangles
             .extend(p.triangles.iter().map(|t| t.map(|v| v + offset)));
+        p.triangles = Vec::new();
         groups.push(start..mesh.triangles.len());
     }
     (mesh, groups)
