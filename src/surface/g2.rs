@@ -122,7 +122,7 @@ struct Local {
 ///
 /// It borrows the mesh (corner positions and normals), its topology (each triangle's edges, and
 /// the neighbour across each blended edge) and the widths instead of copying them; see
-/// [`Patch`].
+/// `Patch`.
 #[derive(Debug)]
 pub struct G2Surface<'a> {
     mesh: &'a TriMesh,
