@@ -29,19 +29,29 @@ pub struct FloatAttribute {
 }
 
 /// The triangles whose corners the sources refer to: `triangles[source.tri - first_tri]` holds
-/// indices into the attribute arrays.
+/// indices into the attribute arrays, offset by `first_vertex`.
+///
+/// The offset lets the triangles be the joined mesh's own (whole-mesh vertex numbers), so a
+/// primitive needs no copy of its triangles in its own numbering.
 #[derive(Debug, Clone, Copy)]
 pub struct SourceTriangles<'a> {
-    /// Corner indices into the attribute arrays.
+    /// Corner indices into the attribute arrays, plus `first_vertex`.
     pub triangles: &'a [[u32; 3]],
     /// The whole-mesh index of `triangles[0]`.
     pub first_tri: u32,
+    /// What every index of `triangles` is above the attribute arrays' own numbering.
+    pub first_vertex: u32,
 }
 
 impl SourceTriangles<'_> {
+    /// The attribute indices of the corners of whole-mesh triangle `tri`.
+    #[inline]
+    pub fn triangle(&self, tri: u32) -> [usize; 3] {
+        self.triangles[(tri - self.first_tri) as usize].map(|v| (v - self.first_vertex) as usize)
+    }
+
     fn corners(&self, source: &VertexSource) -> [usize; 3] {
-        let t = self.triangles[(source.tri - self.first_tri) as usize];
-        [t[0] as usize, t[1] as usize, t[2] as usize]
+        self.triangle(source.tri)
     }
 }
 
@@ -186,6 +196,7 @@ mod tests {
         let tris = SourceTriangles {
             triangles: &[[0, 1, 2]],
             first_tri: 5,
+            first_vertex: 0,
         };
         let out = carry(
             &attr,
@@ -205,6 +216,7 @@ mod tests {
         let tris = SourceTriangles {
             triangles: &[[0, 1, 2]],
             first_tri: 0,
+            first_vertex: 0,
         };
         let out = carry(
             &attr,
@@ -228,6 +240,7 @@ mod tests {
         let tris = SourceTriangles {
             triangles: &[[0, 1, 2]],
             first_tri: 0,
+            first_vertex: 0,
         };
         let out = carry_skin(&skin, tris, &[src(0, 3, 1, 1)]); // the centroid
         let w = out.weights[0][0];

@@ -45,7 +45,7 @@ pub const DEFAULT_SCHEME: Scheme = Scheme::G2;
 pub const DEFAULT_NETS: Nets = Nets::Round;
 /// Default cap on output triangles per input file, so a typo in `level` cannot fill the disk or
 /// the memory: at the measured peak of about 35 bytes per output triangle for positions and
-/// normals, about 370 with regenerated tangents (plus about 410 per input triangle; the upper
+/// normals, about 370 with regenerated tangents (plus about 320 per input triangle; the upper
 /// end is rounded up to [`crate::pipeline::PEAK_BYTES_PER_OUTPUT_TRIANGLE`]), 20 million
 /// triangles need 0.7 to 7 GiB, which leaves room for a desktop session and a second job on a
 /// 24 GiB machine.

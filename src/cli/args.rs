@@ -145,7 +145,7 @@ pub struct Args {
     pub overdraw: bool,
 
     /// Refuse outputs with more triangles than this per file (memory: about 35 bytes each, up to
-    /// 400 with UVs and generated tangents, plus about 410 per input triangle)
+    /// 400 with UVs and generated tangents, plus about 320 per input triangle)
     /// [default: 20000000]
     #[arg(
         long,

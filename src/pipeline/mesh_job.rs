@@ -231,7 +231,7 @@ pub fn smooth_mesh(
     // Every level written is held (and, with MSFT_lod, stored in the one file): the limit is
     // on their sum.
     let mut planned_total = 0u64;
-    // The G² surface holds about 160 bytes per input triangle: freed once the last level is
+    // The G² surface holds about 112 bytes per input triangle: freed once the last level is
     // tessellated, before its attributes are carried, when the dense mesh is at its largest.
     let mut surface = Some(surface);
     let last = levels.len() - 1;
@@ -310,14 +310,20 @@ pub fn smooth_mesh(
             if k == 0 {
                 report.primitives.push(PrimitiveReport {
                     primitive: input.primitives[j].index,
-                    triangles_in: prep.triangles.len(),
+                    triangles_in: groups[j].len(),
                     vertices_in: prep.source_vertex_count,
                     triangles_out: d.indices.len() / 3,
                     vertices_out: d.positions.len(),
                     cache: options.report_figures.then(|| optimize::cache_figures(&d)),
                 });
             }
-            let data = primitive_out::build(prep, d, groups[j].start as u32, target);
+            let data = primitive_out::build(
+                prep,
+                d,
+                &mesh.triangles[groups[j].clone()],
+                groups[j].start as u32,
+                target,
+            );
             refuse_non_finite(&data, input.mesh, input.primitives[j].index, options)
                 .map_err(|e| Error::gltf(asset, e))?;
             level_primitives.push((input.primitives[j].index, data));
@@ -401,12 +407,12 @@ fn lap(clock: &Instant, before: f64) -> f64 {
 }
 
 /// The surface the options ask for, with the warnings its construction gave.
-pub(super) fn build_surface(
+pub(super) fn build_surface<'a>(
     options: &Options,
-    mesh: &TriMesh,
-    topo: &Topology,
-    h: &EffectiveH,
-) -> (Box<dyn Surface>, Vec<scheme::Warning>) {
+    mesh: &'a TriMesh,
+    topo: &'a Topology,
+    h: &'a EffectiveH,
+) -> (Box<dyn Surface + 'a>, Vec<scheme::Warning>) {
     let params = options.scheme_params();
     scheme::build_surface(options.scheme, mesh, topo, h, &params)
 }
@@ -560,22 +566,28 @@ fn repair_normals(
 
 /// The primitives of one mesh as one [`TriMesh`], and each primitive's triangle range in it.
 fn join(prepared: &mut [Prepared]) -> (TriMesh, Vec<Range<usize>>) {
-    // Positions and normals move into the joined mesh (nothing reads them from the primitives
-    // afterwards): a lone primitive's are taken whole, several are copied into arrays sized
-    // once and freed one by one, so no copy outlives the join.
+    // Positions, normals and triangles move into the joined mesh (nothing reads them from the
+    // primitives afterwards; the attributes are carried through the mesh's triangles): a lone
+    // primitive's are taken whole, several are copied into arrays sized once and freed one by
+    // one, so no copy outlives the join.
+    if let [p] = prepared {
+        // Its vertex offset is 0: its triangles are the mesh's as they are.
+        let mesh = TriMesh {
+            positions: std::mem::take(&mut p.positions),
+            normals: std::mem::take(&mut p.normals),
+            triangles: std::mem::take(&mut p.triangles),
+        };
+        let all = 0..mesh.triangles.len();
+        return (mesh, vec![all]);
+    }
     let vertices: usize = prepared.iter().map(|p| p.positions.len()).sum();
     let triangles: usize = prepared.iter().map(|p| p.triangles.len()).sum();
     let mut mesh = TriMesh {
         triangles: Vec::with_capacity(triangles),
         ..TriMesh::default()
     };
-    if let [p] = prepared {
-        mesh.positions = std::mem::take(&mut p.positions);
-        mesh.normals = std::mem::take(&mut p.normals);
-    } else {
-        mesh.positions.reserve_exact(vertices);
-        mesh.normals.reserve_exact(vertices);
-    }
+    mesh.positions.reserve_exact(vertices);
+    mesh.normals.reserve_exact(vertices);
     let mut groups = Vec::with_capacity(prepared.len());
     for p in prepared {
         let offset = p.vertex_offset;
@@ -589,6 +601,7 @@ fn join(prepared: &mut [Prepared]) -> (TriMesh, Vec<Range<usize>>) {
         let start = mesh.triangles.len();
         mesh.triangles
             .extend(p.triangles.iter().map(|t| t.map(|v| v + offset)));
+        p.triangles = Vec::new();
         groups.push(start..mesh.triangles.len());
     }
     (mesh, groups)

@@ -491,7 +491,7 @@ fn needs_tangents(doc: &Document, mesh: usize, prim: usize, data: &PrimitiveData
 /// peak resident size of `g2tess` divided by the triangles written is 421 bytes on
 /// DamagedHelmet at level 8 (UVs and regenerated tangents; 371 per added output triangle from
 /// level 4), rounded up; positions and normals alone take about 35 per output triangle plus
-/// about 410 per input triangle. It turns `--max-triangles` into a memory bound and sizes the
+/// about 320 per input triangle. It turns `--max-triangles` into a memory bound and sizes the
 /// decoding budget.
 pub const PEAK_BYTES_PER_OUTPUT_TRIANGLE: u64 = 512;
 

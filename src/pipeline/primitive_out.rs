@@ -27,7 +27,8 @@ pub struct Prepared {
     /// Unit normals in f64 (input, repaired, or generated); moved out by the join like
     /// `positions`.
     pub normals: Vec<DVec3>,
-    /// Triangles over `positions`.
+    /// Triangles over `positions`; moved into the joined mesh by the join like `positions`
+    /// (in its vertex numbers there, `vertex_offset` on).
     pub triangles: Vec<[u32; 3]>,
     /// The input NORMAL values, kept bit for bit at the corners of the output where they are
     /// unit length to the validator's tolerance (so level 1 with h = 0 reproduces the input exactly).
@@ -132,19 +133,22 @@ fn float_attribute(name: &str, components: usize, values: Vec<f32>) -> Attribute
 }
 
 /// The replacement primitive for `prep`, from its dense mesh `dense` (whose sources refer to
-/// whole-mesh triangle `first_tri` onwards) and its re-evaluated morph targets.
+/// whole-mesh triangle `first_tri` onwards, `triangles` in the joined mesh's vertex numbers)
+/// and its re-evaluated morph targets.
 ///
 /// The dense mesh's positions, normals and indices move into the result uncopied: for a dense
 /// mesh they are most of the memory the process holds.
 pub fn build(
     prep: &Prepared,
     mut dense: DenseMesh,
+    triangles: &[[u32; 3]],
     first_tri: u32,
     targets: Vec<TargetSurface>,
 ) -> PrimitiveData {
     let tris = SourceTriangles {
-        triangles: &prep.triangles,
+        triangles,
         first_tri,
+        first_vertex: prep.vertex_offset,
     };
     keep_exact_corner_normals(prep, &mut dense, tris);
     let dense = dense;
@@ -294,8 +298,7 @@ fn carry_one(a: &Attribute, tris: SourceTriangles<'_>, dense: &DenseMesh) -> Att
                 .sources
                 .iter()
                 .flat_map(|s| {
-                    let t = tris.triangles[(s.tri - tris.first_tri) as usize];
-                    let k = t[s.nearest_corner()] as usize;
+                    let k = tris.triangle(s.tri)[s.nearest_corner()];
                     v[k * c..k * c + c].iter().copied()
                 })
                 .collect();
@@ -340,7 +343,7 @@ fn keep_exact_corner_normals(prep: &Prepared, dense: &mut DenseMesh, tris: Sourc
             let Some(c) = s.corner() else {
                 return;
             };
-            let v = tris.triangles[(s.tri - tris.first_tri) as usize][c] as usize;
+            let v = tris.triangle(s.tri)[c];
             let e = exact[v];
             let len = e.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>().sqrt();
             if (len - 1.0).abs() <= KEPT_NORMAL_TOLERANCE {

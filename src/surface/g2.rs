@@ -15,20 +15,22 @@ use super::pn::{compose, Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::sharpness::EffectiveH;
-use crate::topology::{Edge, EdgeId, Neighbour, Topology, TriId};
+use crate::topology::{Edge, EdgeId, Topology, TriId};
 
 /// A control net by coordinate, `[x, y, z][control point]`: the layout the per-point sums of
 /// [`accumulate`] read, one coordinate of one control point at a time.
 type SoaNet = [[f64; 10]; 3];
 
-/// Everything one triangle needs at evaluation time that no other triangle holds too: 136
-/// bytes, one allocation for the whole mesh.
+/// Everything one triangle needs at evaluation time that the mesh and its topology do not
+/// already hold: 88 bytes, one allocation for the whole mesh.
 ///
-/// The corners' positions and normals live once per input vertex ([`CornerVertex`]), not
-/// once per use of it: every rule of [`Nets`] copies a corner's position into its net bit for
-/// bit and the shared edge curves leave corners alone, so the net is whole again when a
-/// lattice part asks for it ([`G2Surface::local`]). At a million input triangles every byte
-/// held here is a page fault at set-up, and the surface is the run's largest allocation.
+/// The corners' positions and normals are read from the mesh the surface borrows, the
+/// neighbours and edge widths through its topology, not copied: every rule of [`Nets`] copies a corner's position
+/// into its net bit for bit and the shared edge curves leave corners alone, so the net is whole
+/// again when a lattice part asks for it ([`G2Surface::local`]). Both outlive the surface in
+/// the pipeline anyway (the tessellation reads them), so a copy here would only add to the
+/// run's peak, which is reached while the surface is alive: at a million input triangles every
+/// byte held per triangle is a megabyte.
 #[derive(Debug, Clone)]
 struct Patch {
     /// Control points 3 to 9 of the own net `b_f` (Eq. 2 or the round net, with shared edge
@@ -41,21 +43,6 @@ struct Patch {
     /// compute the same flat point from the same two corners, so a curve they share is still
     /// shared bit for bit, and the surface stays watertight exactly as with `f64` points.
     inner: [[f32; INNER]; 3],
-    /// Input vertex of each corner, an index into [`G2Surface::vertices`].
-    verts: [u32; 3],
-    /// `across[k]`: for a blended edge opposite corner `k` (its width above 0), the neighbour
-    /// and its slots, packed by [`Across::pack`], from which [`G2Surface::across_net`]
-    /// composes `b_g ∘ M` (Eq. 3) when a point needs it; meaningless on other edges.
-    ///
-    /// The composed nets are not stored: three of them per triangle were two thirds of the
-    /// surface's memory (720 of 1128 bytes), more than the dense output of a level-8 triangle,
-    /// and composing costs less than the page faults of holding them. Each is composed once per
-    /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
-    /// still agree bit for bit.
-    across: [u32; 3],
-    /// The effective width of the edge opposite each corner: kept here rather than read through
-    /// an edge index, so the surface needs no copy of the per-edge widths.
-    widths: [f64; 3],
     /// Bit `m − 3` set: edge point `m` is an average of split-normal curves (PN-AEN), used as
     /// stored. Every other edge point lies in its corner's tangent plane (both net rules put it
     /// there), and is put back into it exactly when the net is rebuilt ([`local`]): the `f32`
@@ -67,7 +54,7 @@ struct Patch {
 
 /// The bytes a [`Patch`] takes: pinned, since the surface's memory per triangle is a figure the
 /// pipeline is planned around (the run's peak at a million triangles).
-const _: () = assert!(std::mem::size_of::<Patch>() == 136);
+const _: () = assert!(std::mem::size_of::<Patch>() == 88);
 
 /// Control points of a net that are not corners (the corners are slots 0, 1, 2).
 const INNER: usize = 7;
@@ -125,51 +112,29 @@ fn offsets(net: &Net) -> [[f32; INNER]; 3] {
     out
 }
 
-/// An input vertex as every triangle on it reads it.
-#[derive(Debug, Clone, Copy)]
-struct CornerVertex {
-    position: DVec3,
-    /// The normalized input normal, or zero where it has no direction (each triangle then
-    /// uses its own face normal, see [`face_fallback`]).
-    normal: DVec3,
-}
-
 /// One triangle's whole net and corner normals, put together for a lattice part or a point.
 struct Local {
     net: SoaNet,
     normal: [DVec3; 3],
 }
 
-/// The triangle across a blended edge and the slots `[p, q, r]` of [`neighbour_map`], packed
-/// into one `u32` as the topology packs its neighbours: the neighbour's use of the edge
-/// (`3·tri + r`) and one bit for which way round `p` and `q` are. Every mesh whose topology
-/// could be built fits.
-struct Across;
-
-impl Across {
-    fn pack(n: Neighbour) -> u32 {
-        let [p, _, r] = n.slots.map(u32::from);
-        (n.tri.0 * 3 + r) * 2 + u32::from(p != (r + 1) % 3)
-    }
-
-    fn unpack(code: u32) -> (usize, [usize; 3]) {
-        let (tri, r) = ((code >> 1) / 3, (code >> 1) % 3);
-        let (p, q) = ((r + 1) % 3, (r + 2) % 3);
-        let (p, q) = if code & 1 == 0 { (p, q) } else { (q, p) };
-        (tri as usize, [p, q, r].map(|s| s as usize))
-    }
-}
-
 /// The G² blended surface of Lee–Hwang–Yoon over a whole mesh, one width `h` per welded edge.
+///
+/// It borrows the mesh (corner positions and normals), its topology (each triangle's edges, and
+/// the neighbour across each blended edge) and the widths instead of copying them; see
+/// `Patch`.
 #[derive(Debug)]
-pub struct G2Surface {
+pub struct G2Surface<'a> {
+    mesh: &'a TriMesh,
+    topo: &'a Topology,
+    /// One width per welded edge; `None`: 0 on every edge (PN triangles).
+    h: Option<&'a [f64]>,
     patches: Vec<Patch>,
-    vertices: Vec<CornerVertex>,
     profile: Profile,
     patterns: PatternCache,
 }
 
-impl G2Surface {
+impl<'a> G2Surface<'a> {
     /// Builds the surface with the widths `h` the pipeline decided (one per edge of `topo`;
     /// boundary, non-manifold and degenerate edges are 0 there, so they are PN creases). Where
     /// an edge is not blended but its triangles disagree on its boundary curve (split normals),
@@ -178,7 +143,7 @@ impl G2Surface {
     ///
     /// # Panics
     /// If `h`, `topo` and `mesh` do not belong together (a caller bug).
-    pub fn new(mesh: &TriMesh, topo: &Topology, h: &EffectiveH, profile: Profile) -> Self {
+    pub fn new(mesh: &'a TriMesh, topo: &'a Topology, h: &'a EffectiveH, profile: Profile) -> Self {
         Self::with_nets(mesh, topo, h, profile, Nets::default())
     }
 
@@ -187,81 +152,89 @@ impl G2Surface {
     /// # Panics
     /// If `h`, `topo` and `mesh` do not belong together (a caller bug).
     pub fn with_nets(
-        mesh: &TriMesh,
-        topo: &Topology,
-        h: &EffectiveH,
+        mesh: &'a TriMesh,
+        topo: &'a Topology,
+        h: &'a EffectiveH,
         profile: Profile,
         nets_rule: Nets,
     ) -> Self {
-        super::assert_belong_together(mesh, topo, h);
+        super::assert_belong_together(mesh, topo, Some(h));
+        Self::build(mesh, topo, Some(h), profile, nets_rule)
+    }
 
-        let vertices: Vec<CornerVertex> = mesh
-            .positions
-            .par_iter()
-            .zip(&mesh.normals)
-            .map(|(&position, normal)| CornerVertex {
-                position,
-                normal: normal.normalize_or(DVec3::ZERO),
-            })
-            .collect();
+    /// [`G2Surface::with_nets`] with the widths checked; `h`: `None` for 0 on every edge.
+    fn build(
+        mesh: &'a TriMesh,
+        topo: &'a Topology,
+        h: Option<&'a [f64]>,
+        profile: Profile,
+        nets_rule: Nets,
+    ) -> Self {
         // Built in place, in the final array, in one pass: no per-triangle corner or net arrays
         // beside it.
-        let mut patches: Vec<Patch> = (0..mesh.triangles.len())
+        let patches: Vec<Patch> = (0..mesh.triangles.len())
             .into_par_iter()
             .map(|t| {
-                let verts = mesh.triangles[t];
-                let (position, normal) = corners(&vertices, verts);
-                let widths = topo.tri_edges[t].map(|e| h[e.0 as usize]);
-                let across = std::array::from_fn(|k| {
-                    if widths[k] > 0.0 {
-                        let n = topo
-                            .neighbour(TriId(t as u32), k)
-                            .expect("blended edges are interior");
-                        Across::pack(n)
-                    } else {
-                        0
-                    }
-                });
+                let (position, normal) = corners(mesh, mesh.triangles[t]);
                 Patch {
                     inner: offsets(&nets_rule.net(position, normal)),
-                    verts,
-                    across,
-                    widths,
                     as_stored: 0,
                 }
             })
             .collect();
-        share_unblended_edge_curves(topo, h, &vertices, &mut patches, nets_rule);
-
-        G2Surface {
+        let mut surface = G2Surface {
+            mesh,
+            topo,
+            h,
             patches,
-            vertices,
             profile,
             patterns: PatternCache::default(),
+        };
+        debug_assert!((0..mesh.triangles.len()).all(|t| (0..3)
+            .all(|k| surface.widths(t)[k] == 0.0 || topo.neighbour(TriId(t as u32), k).is_some())));
+        share_unblended_edge_curves(mesh, topo, h, &mut surface.patches, nets_rule);
+        surface
+    }
+
+    /// The effective widths of the edges opposite triangle `tri`'s corners.
+    #[inline]
+    fn widths(&self, tri: usize) -> [f64; 3] {
+        match self.h {
+            Some(h) => self.topo.tri_edges[tri].map(|e| h[e.0 as usize]),
+            None => [0.0; 3],
         }
     }
 
-    /// Bytes this surface holds on the heap for its triangles and vertices (capacities, not
-    /// lengths; the pattern cache, shared by all triangles, is not counted).
+    /// Bytes this surface holds on the heap for its triangles (capacities, not lengths; the
+    /// pattern cache, shared by all triangles, and the borrowed mesh and topology are not
+    /// counted).
     pub fn heap_bytes(&self) -> usize {
         self.patches.capacity() * std::mem::size_of::<Patch>()
-            + self.vertices.capacity() * std::mem::size_of::<CornerVertex>()
     }
 
-    /// The neighbour's net across edge `k` of `patch` in `patch`'s barycentrics, `b_g ∘ M`
-    /// (Eq. 3 in the form of [`neighbour_map`]); `k` must be a blended edge.
-    fn across_net(&self, patch: &Patch, k: usize) -> SoaNet {
-        debug_assert!(patch.widths[k] > 0.0, "only blended edges");
-        let (tri, slots) = Across::unpack(patch.across[k]);
-        let g = aos(&self.local(tri).net);
-        soa(&compose(&g, neighbour_map(k, slots)))
+    /// The neighbour's net across edge `k` of triangle `tri` in `tri`'s barycentrics,
+    /// `b_g ∘ M` (Eq. 3 in the form of [`neighbour_map`]); `k` must be a blended edge.
+    ///
+    /// The composed nets are not stored: three of them per triangle were two thirds of the
+    /// surface's memory (720 of 1128 bytes), more than the dense output of a level-8 triangle,
+    /// and composing costs less than the page faults of holding them. Each is composed once per
+    /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
+    /// still agree bit for bit.
+    fn across_net(&self, tri: usize, k: usize) -> SoaNet {
+        debug_assert!(self.widths(tri)[k] > 0.0, "only blended edges");
+        let n = self
+            .topo
+            .neighbour(TriId(tri as u32), k)
+            .expect("blended edges are interior");
+        let g = aos(&self.local(n.tri.0 as usize).net);
+        soa(&compose(&g, neighbour_map(k, n.slots.map(usize::from))))
     }
 
     /// Triangle `tri`'s whole net and corner normals, exactly as they were when its net was
     /// stored.
     #[inline]
     fn local(&self, tri: usize) -> Local {
-        local(&self.vertices, &self.patches[tri])
+        local(self.mesh, tri, &self.patches[tri])
     }
 
     /// The profile `r(s)` in use.
@@ -371,18 +344,22 @@ fn corner(net: &SoaNet, c: usize) -> DVec3 {
 
 /// Positions and unit normals of the corners `verts` as the net rules take them: the
 /// normalized input normals, and the face normal where one has no direction.
+///
+/// Normalized here, each time, rather than once per vertex into an array of their own: the
+/// division costs less than the memory, and it is the same arithmetic on every path, so a
+/// net is rebuilt bit for bit.
 #[inline]
-fn corners(vertices: &[CornerVertex], verts: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
-    let v = verts.map(|v| vertices[v as usize]);
-    let position = v.map(|v| v.position);
+fn corners(mesh: &TriMesh, verts: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
+    let position = verts.map(|v| mesh.positions[v as usize]);
     // Only for the rare vertex without a normal: every patch set-up and every lattice part
     // comes through here.
     let mut face = None;
-    let normal = v.map(|v| {
-        if v.normal == DVec3::ZERO {
+    let normal = verts.map(|v| {
+        let n = mesh.normals[v as usize].normalize_or(DVec3::ZERO);
+        if n == DVec3::ZERO {
             *face.get_or_insert_with(|| face_fallback(position))
         } else {
-            v.normal
+            n
         }
     });
     (position, normal)
@@ -395,10 +372,10 @@ fn face_fallback(p: [DVec3; 3]) -> DVec3 {
     (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(DVec3::Z)
 }
 
-/// A patch's whole net and corner normals (see [`G2Surface::local`]).
+/// Triangle `tri`'s whole net and corner normals from its `patch` (see [`G2Surface::local`]).
 #[inline]
-fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
-    let (position, normal) = corners(vertices, patch.verts);
+fn local(mesh: &TriMesh, tri: usize, patch: &Patch) -> Local {
+    let (position, normal) = corners(mesh, mesh.triangles[tri]);
     let mut net = std::array::from_fn(|x| {
         let p = coordinate(&position, x);
         let mut coord = [0.0; 10];
@@ -412,9 +389,9 @@ fn local(vertices: &[CornerVertex], patch: &Patch) -> Local {
     Local { net, normal }
 }
 
-/// Edge control point `slot` of `patch`, as [`local`] rebuilds it.
-fn edge_point(vertices: &[CornerVertex], patch: &Patch, slot: usize) -> DVec3 {
-    let net = local(vertices, patch).net;
+/// Edge control point `slot` of triangle `tri`'s `patch`, as [`local`] rebuilds it.
+fn edge_point(mesh: &TriMesh, tri: usize, patch: &Patch, slot: usize) -> DVec3 {
+    let net = local(mesh, tri, patch).net;
     DVec3::new(net[0][slot], net[1][slot], net[2][slot])
 }
 
@@ -440,9 +417,9 @@ fn onto_tangent_planes(net: &mut SoaNet, normal: &[DVec3; 3], as_stored: u8) {
     }
 }
 
-/// Stores `value` as control point `slot` (3 to 9) of `patch`.
-fn set_point(vertices: &[CornerVertex], patch: &mut Patch, slot: usize, value: DVec3) {
-    let position = patch.verts.map(|v| vertices[v as usize].position);
+/// Stores `value` as control point `slot` (3 to 9) of triangle `tri`'s `patch`.
+fn set_point(mesh: &TriMesh, tri: usize, patch: &mut Patch, slot: usize, value: DVec3) {
+    let position = mesh.triangles[tri].map(|v| mesh.positions[v as usize]);
     for x in 0..3 {
         let flat = flat_point(coordinate(&position, x), slot);
         patch.inner[x][slot - 3] = (value[x] - flat) as f32;
@@ -452,21 +429,20 @@ fn set_point(vertices: &[CornerVertex], patch: &mut Patch, slot: usize, value: D
 /// One patch set up for single points: its net broadcast once, and each neighbour's net
 /// composed (Eq. 3) the first time a point blends across that edge, then kept. A single point
 /// and a batch of them run the same arithmetic, so they agree bit for bit.
-struct PointEvaluation<'a> {
-    patch: &'a Patch,
+struct PointEvaluation {
+    tri: usize,
     widths: [f64; 3],
     local: Local,
     own: Broadcast<1>,
     across: [Option<Broadcast<1>>; 3],
 }
 
-impl<'a> PointEvaluation<'a> {
-    fn new(surface: &'a G2Surface, tri: usize) -> Self {
-        let patch = &surface.patches[tri];
+impl PointEvaluation {
+    fn new(surface: &G2Surface, tri: usize) -> Self {
         let local = surface.local(tri);
         PointEvaluation {
-            patch,
-            widths: patch.widths,
+            tri,
+            widths: surface.widths(tri),
             own: broadcast(&local.net),
             local,
             across: [None; 3],
@@ -482,17 +458,17 @@ impl<'a> PointEvaluation<'a> {
                 normal: self.local.normal[c],
             };
         }
-        let patch = self.patch;
+        let tri = self.tri;
         let net = w.blended.then(|| {
             let k = w.k as usize;
-            &*self.across[k].get_or_insert_with(|| broadcast(&surface.across_net(patch, k)))
+            &*self.across[k].get_or_insert_with(|| broadcast(&surface.across_net(tri, k)))
         });
         let [p] = G2Surface::combine(&self.local.normal, &Lanes::<1>::single(&w), &self.own, net);
         p
     }
 }
 
-impl Surface for G2Surface {
+impl Surface for G2Surface<'_> {
     fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
         let mut out = PointEvaluation::new(self, tri);
         out.at(self, bary)
@@ -535,22 +511,23 @@ impl Surface for G2Surface {
 /// neighbour's net composed (Eq. 3) the first time a part blends across that edge, then kept.
 /// The values are those a part evaluated alone computes, so parts evaluated together or apart
 /// agree bit for bit.
-struct PartEvaluation<'a> {
-    surface: &'a G2Surface,
-    patch: &'a Patch,
+struct PartEvaluation<'s, 'a> {
+    surface: &'s G2Surface<'a>,
+    tri: usize,
+    widths: [f64; 3],
     local: Local,
     own: Broadcast<LANES>,
     across: [Option<Broadcast<LANES>>; 3],
 }
 
-impl<'a> PartEvaluation<'a> {
+impl<'s, 'a> PartEvaluation<'s, 'a> {
     #[inline]
-    fn new(surface: &'a G2Surface, tri: usize) -> Self {
-        let patch = &surface.patches[tri];
+    fn new(surface: &'s G2Surface<'a>, tri: usize) -> Self {
         let local = surface.local(tri);
         PartEvaluation {
             surface,
-            patch,
+            tri,
+            widths: surface.widths(tri),
             own: broadcast(&local.net),
             local,
             across: [None; 3],
@@ -562,14 +539,15 @@ impl<'a> PartEvaluation<'a> {
     fn part(&mut self, level: u32, part: LatticePart, out: &mut Vec<SurfacePoint>) {
         let PartEvaluation {
             surface,
-            patch,
+            tri,
+            widths,
             local,
             own,
             across,
         } = self;
         surface
             .patterns
-            .with(level, part, patch.widths, surface.profile, |pattern| {
+            .with(level, part, *widths, surface.profile, |pattern| {
                 let base = out.len();
                 out.resize(
                     base + pattern.len,
@@ -592,7 +570,7 @@ impl<'a> PartEvaluation<'a> {
                         continue;
                     }
                     let across = k.map(|k| {
-                        &*across[k].get_or_insert_with(|| broadcast(&surface.across_net(patch, k)))
+                        &*across[k].get_or_insert_with(|| broadcast(&surface.across_net(*tri, k)))
                     });
                     for lanes in blocks {
                         let points = G2Surface::combine(&local.normal, lanes, own, across);
@@ -610,28 +588,24 @@ impl<'a> PartEvaluation<'a> {
 /// Plain PN triangles (Vlachos et al. 2001; paper Eq. 1–2): the G² surface with h = 0 on every
 /// edge, including its shared edge curves across split normals.
 #[derive(Debug)]
-pub struct PnSurface(G2Surface);
+pub struct PnSurface<'a>(G2Surface<'a>);
 
-impl PnSurface {
+impl<'a> PnSurface<'a> {
     /// PN triangles over `mesh`, on the default nets.
-    pub fn new(mesh: &TriMesh, topo: &Topology) -> Self {
+    pub fn new(mesh: &'a TriMesh, topo: &'a Topology) -> Self {
         Self::with_nets(mesh, topo, Nets::default())
     }
 
     /// PN triangles over `mesh` on nets made by the rule `nets` ([`Nets::Paper`]: Vlachos et
     /// al. as published).
-    pub fn with_nets(mesh: &TriMesh, topo: &Topology, nets: Nets) -> Self {
-        PnSurface(G2Surface::with_nets(
-            mesh,
-            topo,
-            &EffectiveH::zero(topo),
-            Profile::default(),
-            nets,
-        ))
+    pub fn with_nets(mesh: &'a TriMesh, topo: &'a Topology, nets: Nets) -> Self {
+        // No width table: every edge is at 0.
+        super::assert_belong_together(mesh, topo, None);
+        PnSurface(G2Surface::build(mesh, topo, None, Profile::default(), nets))
     }
 }
 
-impl Surface for PnSurface {
+impl Surface for PnSurface<'_> {
     fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
         self.0.evaluate(tri, bary)
     }
@@ -669,21 +643,21 @@ impl Surface for PnSurface {
 /// they are compared in parallel, and only the few that differ are written afterwards, in edge
 /// order. The result does not depend on the order either way.
 fn share_unblended_edge_curves(
+    mesh: &TriMesh,
     topo: &Topology,
-    h_edge: &[f64],
-    vertices: &[CornerVertex],
+    h_edge: Option<&[f64]>,
     patches: &mut [Patch],
     rule: Nets,
 ) {
     // Edge points only: never a corner.
-    let point = |t: usize, s: usize| edge_point(vertices, &patches[t], s);
+    let point = |t: usize, s: usize| edge_point(mesh, t, &patches[t], s);
     let uses = |edge| edge_uses(topo, edge);
     let averaged: Vec<(usize, [DVec3; 2])> = topo
         .par_edges()
-        .zip(h_edge.par_iter())
         .enumerate()
-        .filter_map(|(e, (edge, &h))| {
-            if h > 0.0 || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
+        .filter_map(|(e, edge)| {
+            let blended = h_edge.is_some_and(|h| h[e] > 0.0);
+            if blended || edge.tris.len() < 2 || edge.verts[0] == edge.verts[1] {
                 return None;
             }
             let mut all = uses(edge);
@@ -707,7 +681,7 @@ fn share_unblended_edge_curves(
     for (e, avg) in averaged {
         for (t, s) in uses(topo.edge(EdgeId(e as u32))) {
             for (slot, value) in s.into_iter().zip(avg) {
-                set_point(vertices, &mut patches[t], slot, value);
+                set_point(mesh, t, &mut patches[t], slot, value);
                 patches[t].as_stored |= 1 << (slot - 3);
             }
             touched.push(t as u32);
@@ -716,10 +690,10 @@ fn share_unblended_edge_curves(
     touched.sort_unstable();
     touched.dedup();
     for t in touched {
-        let patch = &mut patches[t as usize];
-        let Local { net, normal } = local(vertices, patch);
+        let t = t as usize;
+        let Local { net, normal } = local(mesh, t, &patches[t]);
         let centre = rule.centre(&aos(&net), normal);
-        set_point(vertices, patch, B111, centre);
+        set_point(mesh, t, &mut patches[t], B111, centre);
     }
 }
 

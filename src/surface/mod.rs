@@ -64,9 +64,12 @@ pub const H_MAX: f64 = std::f64::consts::SQRT_2 / 4.0;
 /// bounds far from its cause.
 ///
 /// # Panics
-/// If `topo` was not built from `mesh`, or `h_per_edge` is not one value per welded edge.
-pub(crate) fn assert_belong_together(mesh: &TriMesh, topo: &Topology, h_per_edge: &[f64]) {
-    assert_eq!(h_per_edge.len(), topo.edge_count(), "one h per welded edge");
+/// If `topo` was not built from `mesh`, or `h_per_edge` (when given) is not one value per
+/// welded edge.
+pub(crate) fn assert_belong_together(mesh: &TriMesh, topo: &Topology, h_per_edge: Option<&[f64]>) {
+    if let Some(h) = h_per_edge {
+        assert_eq!(h.len(), topo.edge_count(), "one h per welded edge");
+    }
     assert_eq!(
         topo.tri_verts.len(),
         mesh.triangles.len(),

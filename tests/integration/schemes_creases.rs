@@ -49,7 +49,8 @@ fn h_zero_is_a_watertight_crease_in_every_scheme() {
     ] {
         let topo = Topology::build(&mesh);
         for (name, scheme, params) in schemes() {
-            let (s, w) = build_surface(scheme, &mesh, &topo, &h_all(&topo, 0.0), &params);
+            let h_s = h_all(&topo, 0.0);
+            let (s, w) = build_surface(scheme, &mesh, &topo, &h_s, &params);
             assert!(w.is_empty(), "{w:?}");
             let r = continuity::measure(s.as_ref(), &topo, &sampling());
             println!(
@@ -69,7 +70,8 @@ fn each_side_keeps_its_own_tangent_plane_at_a_crease() {
     let mesh = split_normals(&bumpy_sphere(), 0.5);
     let topo = Topology::build(&mesh);
     for (name, scheme, params) in schemes() {
-        let (s, _) = build_surface(scheme, &mesh, &topo, &h_all(&topo, 0.0), &params);
+        let h_s = h_all(&topo, 0.0);
+        let (s, _) = build_surface(scheme, &mesh, &topo, &h_s, &params);
         let mut worst: f64 = 0.0;
         for (t, tri) in mesh.triangles.iter().enumerate() {
             for c in 0..3 {
@@ -98,7 +100,8 @@ fn mixed_h_gives_g1_on_smooth_edges_and_creases_elsewhere() {
         .collect();
     let l = continuity::mean_edge_length(&topo);
     for (name, scheme, params) in schemes() {
-        let (s, _) = build_surface(scheme, &mesh, &topo, &widths(&topo, &h), &params);
+        let h_s = widths(&topo, &h);
+        let (s, _) = build_surface(scheme, &mesh, &topo, &h_s, &params);
         let jumps = edge_jumps(s.as_ref(), &topo, 11, 0.02);
         let mut crease_max: f64 = 0.0;
         for (e, gap, angle) in jumps {
@@ -208,7 +211,8 @@ fn degenerate_triangles_evaluate_to_finite_points() {
     assert!(topo.degenerate[mesh.triangles.len() - 1]);
     let mut rng = Lcg(2);
     for (name, scheme, params) in schemes() {
-        let (s, _) = build_surface(scheme, &mesh, &topo, &h_all(&topo, 0.2), &params);
+        let h_s = h_all(&topo, 0.2);
+        let (s, _) = build_surface(scheme, &mesh, &topo, &h_s, &params);
         for t in 0..mesh.triangles.len() {
             let p = s.evaluate(t, rng.bary(0.0));
             assert!(

@@ -52,7 +52,8 @@ fn distance_to_the_exact_surface_per_scheme() {
         let topo = Topology::build(&mesh);
         let mut by_scheme = Vec::new();
         for (name, scheme, params, h) in variants() {
-            let (s, _) = build_surface(scheme, &mesh, &topo, &h_all(&topo, h), &params);
+            let h_s = h_all(&topo, h);
+            let (s, _) = build_surface(scheme, &mesh, &topo, &h_s, &params);
             let (max, rms) = distance(s.as_ref(), mesh.triangles.len(), exact, 16);
             println!("| {mesh_name} | {name} | {max:.2e} | {rms:.2e} |");
             by_scheme.push((name, max));
@@ -89,7 +90,8 @@ fn corners_are_the_input_vertices_and_normals_bit_for_bit() {
     for mesh in [split_normals(&bumpy_sphere(), 0.5), height_field(4)] {
         let topo = Topology::build(&mesh);
         for (_, scheme, params, h) in variants() {
-            let (s, _) = build_surface(scheme, &mesh, &topo, &h_all(&topo, h), &params);
+            let h_s = h_all(&topo, h);
+            let (s, _) = build_surface(scheme, &mesh, &topo, &h_s, &params);
             for (t, tri) in mesh.triangles.iter().enumerate() {
                 for c in 0..3 {
                     let mut l = [0.0; 3];
@@ -110,7 +112,8 @@ fn flat_mesh_with_equal_normals_stays_flat() {
     let topo = Topology::build(&mesh);
     let mut rng = Lcg(5);
     for (name, scheme, params, h) in variants() {
-        let (s, _) = build_surface(scheme, &mesh, &topo, &h_all(&topo, h), &params);
+        let h_s = h_all(&topo, h);
+        let (s, _) = build_surface(scheme, &mesh, &topo, &h_s, &params);
         for t in 0..mesh.triangles.len() {
             for _ in 0..20 {
                 let p = s.evaluate(t, rng.bary(0.0));
@@ -128,8 +131,10 @@ fn reordering_and_reversing_triangles_does_not_move_the_surface() {
     let (topo, topo_re) = (Topology::build(&mesh), Topology::build(&re.mesh));
     let mut rng = Lcg(9);
     for (name, scheme, params, h) in variants() {
-        let (a, _) = build_surface(scheme, &mesh, &topo, &h_all(&topo, h), &params);
-        let (b, _) = build_surface(scheme, &re.mesh, &topo_re, &h_all(&topo_re, h), &params);
+        let h_a = h_all(&topo, h);
+        let (a, _) = build_surface(scheme, &mesh, &topo, &h_a, &params);
+        let h_b = h_all(&topo_re, h);
+        let (b, _) = build_surface(scheme, &re.mesh, &topo_re, &h_b, &params);
         for t in 0..mesh.triangles.len() {
             let l = rng.bary(0.0);
             let (p, q) = (a.evaluate(t, l), b.evaluate(t, re.bary(t, l)));
@@ -170,13 +175,8 @@ fn analytic_normals_match_central_differences() {
         let topo = Topology::build(&mesh);
         for h in [0.0, 0.2] {
             for scheme in [Scheme::Hybrid, Scheme::Coons] {
-                let (s, _) = build_surface(
-                    scheme,
-                    &mesh,
-                    &topo,
-                    &h_all(&topo, h),
-                    &SchemeParams::default(),
-                );
+                let h_s = h_all(&topo, h);
+                let (s, _) = build_surface(scheme, &mesh, &topo, &h_s, &SchemeParams::default());
                 let worst = worst_fd_angle(s.as_ref(), &mesh, 3);
                 assert!(worst < 1e-5, "{name} {scheme} h={h}: {worst}°");
             }

@@ -12,7 +12,8 @@ const GAP_TOL: f64 = 1e-13;
 
 fn report(mesh: &g2tess::mesh::TriMesh, h: f64, profile: Profile) -> continuity::ContinuityReport {
     let topo = Topology::build(mesh);
-    let s = G2Surface::new(mesh, &topo, &h_all(&topo, h), profile);
+    let h_s = h_all(&topo, h);
+    let s = G2Surface::new(mesh, &topo, &h_s, profile);
     continuity::measure(&s, &topo, &Sampling::default())
 }
 
@@ -94,7 +95,8 @@ fn split_normals_stay_watertight_at_h_zero_and_close_for_h_above() {
 /// interior edge, halfway into the blending region, at distance `eps` either side of the line.
 fn switch_line_jump(mesh: &g2tess::mesh::TriMesh, h: f64, profile: Profile, eps: f64) -> f64 {
     let topo = Topology::build(mesh);
-    let s = G2Surface::new(mesh, &topo, &h_all(&topo, h), profile);
+    let h_s = h_all(&topo, h);
+    let s = G2Surface::new(mesh, &topo, &h_s, profile);
     let l = continuity::mean_edge_length(&topo);
     let mut worst: f64 = 0.0;
     for e in topo.edges().filter(|e| e.kind == EdgeKind::Interior) {
@@ -155,7 +157,8 @@ fn analytic_normals_match_central_differences() {
         let topo = Topology::build(&mesh);
         for h in [0.0, 0.106, 0.212, H_MAX] {
             for profile in [Profile::Paper, Profile::C2] {
-                let s = G2Surface::new(&mesh, &topo, &h_all(&topo, h), profile);
+                let h_s = h_all(&topo, h);
+                let s = G2Surface::new(&mesh, &topo, &h_s, profile);
                 for _ in 0..200 {
                     let t = (rng.next() * mesh.triangles.len() as f64) as usize;
                     let l = rng.bary(0.01);

@@ -75,7 +75,8 @@ fn flat_mesh_with_equal_normals_stays_exactly_flat() {
     let mut rng = Lcg(5);
     let h: Vec<f64> = topo.edges().map(|_| rng.next() * H_MAX).collect();
     for profile in [Profile::Paper, Profile::C2] {
-        let s = G2Surface::new(&mesh, &topo, &widths(&topo, &h), profile);
+        let h_s = widths(&topo, &h);
+        let s = G2Surface::new(&mesh, &topo, &h_s, profile);
         for t in 0..mesh.triangles.len() {
             let mut out = Vec::new();
             s.evaluate_lattice(t, 9, &mut out);
@@ -95,7 +96,8 @@ fn corners_are_the_input_vertices_bit_for_bit() {
     let mesh = split_normals(&bumpy_sphere(), 0.5);
     let topo = Topology::build(&mesh);
     for h in [0.0, 0.212] {
-        let s = G2Surface::new(&mesh, &topo, &h_all(&topo, h), Profile::C2);
+        let h_s = h_all(&topo, h);
+        let s = G2Surface::new(&mesh, &topo, &h_s, Profile::C2);
         for (t, tri) in mesh.triangles.iter().enumerate() {
             for c in 0..3 {
                 let mut l = [0.0; 3];
@@ -118,7 +120,8 @@ fn lattice_evaluation_equals_point_evaluation() {
         .edges()
         .map(|_| (rng.next() * 4.0).floor() * 0.1)
         .collect();
-    let s = G2Surface::new(&mesh, &topo, &widths(&topo, &h), Profile::C2);
+    let h_s = widths(&topo, &h);
+    let s = G2Surface::new(&mesh, &topo, &h_s, Profile::C2);
     for level in [1, 4, 7] {
         for t in 0..mesh.triangles.len() {
             let mut out = Vec::new();
@@ -163,8 +166,10 @@ fn reordering_corners_or_flipping_triangles_does_not_move_the_surface() {
             let h1: Vec<f64> = topo.edges().map(|e| h_of(&topo, &e)).collect();
             let h2: Vec<f64> = topo2.edges().map(|e| h_of(&topo2, &e)).collect();
             for profile in [Profile::Paper, Profile::C2] {
-                let s1 = G2Surface::new(&mesh, &topo, &widths(&topo, &h1), profile);
-                let s2 = G2Surface::new(&re.mesh, &topo2, &widths(&topo2, &h2), profile);
+                let h_s1 = widths(&topo, &h1);
+                let s1 = G2Surface::new(&mesh, &topo, &h_s1, profile);
+                let h_s2 = widths(&topo2, &h2);
+                let s2 = G2Surface::new(&re.mesh, &topo2, &h_s2, profile);
                 let mut worst: f64 = 0.0;
                 for t in 0..mesh.triangles.len() {
                     for _ in 0..10 {

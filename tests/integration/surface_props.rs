@@ -47,7 +47,8 @@ fn reorder(mesh: &mut TriMesh, rot: &[usize], flip: &[bool]) {
 /// interior edge, and corners exact.
 fn check(mesh: &TriMesh, h: f64, profile: Profile) -> Result<(), TestCaseError> {
     let topo = Topology::build(mesh);
-    let s = G2Surface::new(mesh, &topo, &h_all(&topo, h), profile);
+    let h_s = h_all(&topo, h);
+    let s = G2Surface::new(mesh, &topo, &h_s, profile);
     // The blend reaches r ≤ h from the edge: eps must be well inside that to see G2.
     let sampling = Sampling {
         eps: vec![h * 1e-2, h * 1e-3, h * 1e-4],
@@ -135,7 +136,8 @@ proptest! {
         // per unit near its corner, and that is still G1. 1e-6° is the rounding floor of the
         // normal at unit scale.
         let topo = Topology::build(&mesh);
-        let s = G2Surface::new(&mesh, &topo, &h_all(&topo, h), profile);
+        let h_s = h_all(&topo, h);
+        let s = G2Surface::new(&mesh, &topo, &h_s, profile);
         let angle_at = |t: usize, c: usize, d: f64| {
             let mut l = [d / 2.0; 3];
             l[c] = 1.0 - d;

@@ -144,7 +144,7 @@ impl CoonsSurface {
         h_per_edge: &EffectiveH,
         params: &SchemeParams,
     ) -> Self {
-        super::assert_belong_together(mesh, topo, h_per_edge);
+        super::assert_belong_together(mesh, topo, Some(h_per_edge));
         let (corners, nets, smooth, warnings) = match params.constituents {
             Constituents::PnAverage => pn_average(mesh, topo, h_per_edge),
             Constituents::FoleyOpitz => {

@@ -89,7 +89,7 @@ impl EdgeNets {
         h_per_edge: &EffectiveH,
         reading: PaperReading,
     ) -> Self {
-        super::assert_belong_together(mesh, topo, h_per_edge);
+        super::assert_belong_together(mesh, topo, Some(h_per_edge));
         let corners: Vec<Corners> = (0..mesh.triangles.len())
             .map(|t| Corners::of(mesh, t))
             .collect();

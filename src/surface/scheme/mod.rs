@@ -160,13 +160,13 @@ impl fmt::Display for Warning {
 ///
 /// # Panics
 /// If `h_per_edge`, `topo` and `mesh` do not belong together (a caller bug).
-pub fn build_surface(
+pub fn build_surface<'a>(
     scheme: Scheme,
-    mesh: &TriMesh,
-    topo: &Topology,
-    h_per_edge: &EffectiveH,
+    mesh: &'a TriMesh,
+    topo: &'a Topology,
+    h_per_edge: &'a EffectiveH,
     params: &SchemeParams,
-) -> (Box<dyn Surface>, Vec<Warning>) {
+) -> (Box<dyn Surface + 'a>, Vec<Warning>) {
     match scheme {
         Scheme::G2 => (
             Box::new(G2Surface::with_nets(
