@@ -379,7 +379,13 @@ impl SegmentCounts {
                 for (k, e) in topo.tri_edges[t].into_iter().enumerate() {
                     if error.edges[k] > tolerance {
                         let e = e.0 as usize;
-                        let next = scale(edges_before[e], error.edges[k]);
+                        let mut next = scale(edges_before[e], error.edges[k]);
+                        // An edge below its triangle's inner level is raised to that level
+                        // at most: the uniform lattice there meets what the lattice check
+                        // already passed, and a larger count raises the inner level with it.
+                        if edges_before[e] < self.inner[t] {
+                            next = next.min(self.inner[t]);
+                        }
                         raised |= next > self.edges[e];
                         self.edges[e] = self.edges[e].max(next);
                     }
