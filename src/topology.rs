@@ -489,26 +489,8 @@ fn group_uses(tri_verts: &[[VertId; 3]], vertex_count: usize) -> Grouped {
             out.copy_from_slice(&p.edge_verts);
         },
     );
-    let use_start = side_by_side(
-        &parts,
-        (0, Some(sides as u32)),
-        |p| p.use_start.len(),
-        |i, p, out| {
-            for (o, &x) in out.iter_mut().zip(&p.use_start) {
-                *o = use_base[i] as u32 + x;
-            }
-        },
-    );
-    let first_edge = side_by_side(
-        &parts,
-        (0, Some(edge_count as u32)),
-        |p| p.first_edge.len(),
-        |i, p, out| {
-            for (o, &x) in out.iter_mut().zip(&p.first_edge) {
-                *o = edge_base[i] as u32 + x;
-            }
-        },
-    );
+    let use_start = offsets_side_by_side(&parts, |p| &p.use_start, &use_base, sides);
+    let first_edge = offsets_side_by_side(&parts, |p| &p.first_edge, &edge_base, edge_count);
     drop(parts);
 
     let tri_edges = tri_verts
@@ -560,6 +542,26 @@ fn side_by_side<T: Copy + Send>(
         .enumerate()
         .for_each(|(i, piece)| fill(i, &parts[i], piece));
     out
+}
+
+/// An offset array of every part side by side, each part's offsets shifted by what comes before
+/// it (`base`), closed by `end`.
+fn offsets_side_by_side(
+    parts: &[Part],
+    offsets: fn(&Part) -> &Vec<u32>,
+    base: &[usize],
+    end: usize,
+) -> Vec<u32> {
+    side_by_side(
+        parts,
+        (0, Some(end as u32)),
+        |p| offsets(p).len(),
+        |i, p, out| {
+            for (o, &x) in out.iter_mut().zip(offsets(p)) {
+                *o = base[i] as u32 + x;
+            }
+        },
+    )
 }
 
 /// The end points of a side, smaller first.
