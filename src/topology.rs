@@ -207,15 +207,15 @@ impl Topology {
             "a topology holds at most {MAX_TRIANGLES} triangles"
         );
         let (welded_of_vertex, welded_positions) = weld(&mesh.positions);
-        let tri_verts: Vec<[VertId; 3]> = mesh
+        // One pass over the triangles for their welded corners and whether they are degenerate.
+        let (tri_verts, degenerate): (Vec<[VertId; 3]>, Vec<bool>) = mesh
             .triangles
             .par_iter()
-            .map(|t| t.map(|c| welded_of_vertex[c as usize]))
-            .collect();
-        let degenerate: Vec<bool> = tri_verts
-            .par_iter()
-            .map(|v| is_degenerate(v, &welded_positions))
-            .collect();
+            .map(|t| {
+                let v = t.map(|c| welded_of_vertex[c as usize]);
+                (v, is_degenerate(&v, &welded_positions))
+            })
+            .unzip();
         let Grouped {
             uses,
             edge_verts,
@@ -387,25 +387,48 @@ impl Topology {
 
 /// Welds bit-equal positions (after mapping -0.0 to +0.0), numbering them by first use.
 ///
-/// Sorting (key, index) pairs groups equal positions with their first use at the head: half
-/// the memory of a hash map over every vertex, and parallel.
+/// Sorting (hash, index) pairs groups equal positions with their first use at the head: half
+/// the memory of a hash map over every vertex, and parallel. The pairs are 16 bytes where the
+/// (position bits, index) pairs they replace were 32, which halves what the sort moves; the
+/// rare run of equal hashes is ordered by the position bits themselves, so the result is the
+/// one a sort by position gives, whatever the hash.
 fn weld(positions: &[DVec3]) -> (Vec<VertId>, Vec<DVec3>) {
+    weld_by(positions, position_hash)
+}
+
+/// [`weld`] with the hash given, so that tests can make every position collide.
+fn weld_by(
+    positions: &[DVec3],
+    hash: impl Fn([u64; 3]) -> u64 + Sync,
+) -> (Vec<VertId>, Vec<DVec3>) {
     // x + 0.0 is +0.0 for x = -0.0 and x itself otherwise.
-    let key = |p: &DVec3| [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
-    let mut sorted: Vec<([u64; 3], u32)> = positions
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| (key(p), i as u32))
+    let key = |i: u32| {
+        let p = positions[i as usize];
+        [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits)
+    };
+    let mut sorted: Vec<(u64, u32)> = (0..positions.len() as u32)
+        .into_par_iter()
+        .map(|i| (hash(key(i)), i))
         .collect();
     // Entries are distinct (the index differs), so the parallel sort's order is the one there is.
     sorted.par_sort_unstable();
     // `first[i]`: the first input vertex at vertex i's position.
     let mut first = vec![0u32; positions.len()];
     let mut distinct = 0;
-    for group in sorted.chunk_by(|a, b| a.0 == b.0) {
-        distinct += 1;
-        for &(_, i) in group {
-            first[i as usize] = group[0].1;
+    for run in sorted.chunk_by_mut(|a, b| a.0 == b.0) {
+        if run.len() == 1 {
+            let i = run[0].1;
+            distinct += 1;
+            first[i as usize] = i;
+            continue;
+        }
+        // Equal hashes: copies of one position, or (rarely) different positions.
+        run.sort_unstable_by_key(|&(_, i)| (key(i), i));
+        for group in run.chunk_by(|a, b| key(a.1) == key(b.1)) {
+            distinct += 1;
+            for &(_, i) in group {
+                first[i as usize] = group[0].1;
+            }
         }
     }
     drop(sorted);
@@ -424,6 +447,18 @@ fn weld(positions: &[DVec3]) -> (Vec<VertId>, Vec<DVec3>) {
     (first.into_iter().map(VertId).collect(), welded)
 }
 
+/// A 64-bit hash of a position's bits: equal bits give equal hashes. Each coordinate passes
+/// through the SplitMix64 finalizer, so that positions read from `f32` (whose low 29 bits are
+/// zero) still spread over every bit.
+fn position_hash(bits: [u64; 3]) -> u64 {
+    fn mix(mut z: u64) -> u64 {
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    mix(mix(mix(bits[0]) ^ bits[1]) ^ bits[2])
+}
+
 /// The uses of all edges grouped edge by edge, and what indexes them.
 struct Grouped {
     uses: Vec<EdgeUse>,
@@ -436,62 +471,69 @@ struct Grouped {
 /// order and each edge's uses in (triangle, corner) order.
 ///
 /// The smaller end points are cut into ranges, one task each, and every task scans all sides
-/// for its own: a counting sort puts its sides into one bucket per vertex, each side packed in
-/// one `u64` as (larger end point, use), so that sorting a bucket's plain integers orders it by
-/// edge and then by use, with no lookup of the triangles per comparison. Linear in the corners
-/// plus the sort of each vertex's own sides, parallel without a shared write, and the result
-/// does not depend on how the vertices were cut. Each triangle side then finds its edge among
-/// those of its smaller end point (a binary search, so a vertex on 100 000 edges costs a
+/// for its own. A counting sort puts a range's sides into one bucket per vertex, straight into
+/// the final array of uses (with each side's larger end point beside it in a second array), and
+/// each bucket is then sorted by (larger end point, use) as plain `u64`s, with no lookup of the
+/// triangles per comparison. The edges are counted first, so the edge arrays too are written in
+/// place, each range into its own piece: no array is built twice and copied. Linear in the
+/// corners plus the sort of each vertex's own sides, parallel without a shared write, and the
+/// result does not depend on how the vertices were cut. Each triangle side then finds its edge
+/// among those of its smaller end point (a binary search, so a vertex on 100 000 edges costs a
 /// logarithm, not a scan).
 fn group_uses(tri_verts: &[[VertId; 3]], vertex_count: usize) -> Grouped {
     let sides = 3 * tri_verts.len();
-    // A few ranges per thread at most: each range reads every side once.
+    // A few ranges per thread at most: each range reads every side once per pass.
     let ranges = if sides < PARALLEL_SIDES {
         1
     } else {
         rayon::current_num_threads().clamp(1, 8)
     };
     let cut = |i: usize| i * vertex_count / ranges;
-    let parts: Vec<Part> = (0..ranges)
+    let vertex_ranges: Vec<Range<usize>> = (0..ranges).map(|i| cut(i)..cut(i + 1)).collect();
+    let buckets: Vec<Vec<u32>> = vertex_ranges
+        .par_iter()
+        .map(|r| bucket_starts(tri_verts, r.clone()))
+        .collect();
+    let side_counts: Vec<usize> = buckets.iter().map(|b| b[b.len() - 1] as usize).collect();
+
+    // Every range's sides, bucket by bucket, and the larger end point of each.
+    let mut uses = vec![EdgeUse(0); sides];
+    let mut ends = vec![0u32; sides];
+    let edge_counts: Vec<usize> = pieces_of(&mut uses, &side_counts)
         .into_par_iter()
-        .map(|i| Part::of(tri_verts, cut(i)..cut(i + 1)))
+        .zip(pieces_of(&mut ends, &side_counts))
+        .enumerate()
+        .map(|(i, (uses, ends))| {
+            fill_buckets(tri_verts, vertex_ranges[i].clone(), &buckets[i], uses, ends)
+        })
         .collect();
 
-    // The parts side by side, in vertex order: their uses, edges and offsets shifted by what
-    // comes before them, each part copied by its own task.
-    let sums = |len: fn(&Part) -> usize| -> Vec<usize> {
-        let mut at = 0;
-        parts
-            .iter()
-            .map(|p| {
-                at += len(p);
-                at - len(p)
-            })
-            .collect()
-    };
-    let (use_base, edge_base) = (sums(|p| p.sides.len()), sums(|p| p.edge_verts.len()));
-    let edge_count: usize = parts.iter().map(|p| p.edge_verts.len()).sum();
-    let uses = side_by_side(
-        &parts,
-        (EdgeUse(0), None),
-        |p| p.sides.len(),
-        |_, p, out| {
-            for (o, &x) in out.iter_mut().zip(&p.sides) {
-                *o = EdgeUse(x as u32);
-            }
-        },
-    );
-    let edge_verts = side_by_side(
-        &parts,
-        ([VertId(0); 2], None),
-        |p| p.edge_verts.len(),
-        |_, p, out| {
-            out.copy_from_slice(&p.edge_verts);
-        },
-    );
-    let use_start = offsets_side_by_side(&parts, |p| &p.use_start, &use_base, sides);
-    let first_edge = offsets_side_by_side(&parts, |p| &p.first_edge, &edge_base, edge_count);
-    drop(parts);
+    // The edges of each range, in place.
+    let edge_count: usize = edge_counts.iter().sum();
+    let mut edge_verts = vec![[VertId(0); 2]; edge_count];
+    let mut use_start = vec![0u32; edge_count + 1];
+    let mut first_edge = vec![0u32; vertex_count + 1];
+    use_start[edge_count] = sides as u32;
+    first_edge[vertex_count] = edge_count as u32;
+    let vertex_counts: Vec<usize> = vertex_ranges.iter().map(Range::len).collect();
+    let before = |counts: &[usize], i: usize| counts[..i].iter().sum::<usize>();
+    pieces_of(&mut edge_verts, &edge_counts)
+        .into_par_iter()
+        .zip(pieces_of(&mut use_start[..edge_count], &edge_counts))
+        .zip(pieces_of(&mut first_edge[..vertex_count], &vertex_counts))
+        .enumerate()
+        .for_each(|(i, ((edge_verts, use_start), first_edge))| {
+            let (from, to) = (before(&side_counts, i), before(&side_counts, i + 1));
+            let range = RangeEdges {
+                vertices: vertex_ranges[i].clone(),
+                buckets: &buckets[i],
+                ends: &ends[from..to],
+                first_use: from as u32,
+                first_edge: before(&edge_counts, i) as u32,
+            };
+            range.write(edge_verts, use_start, first_edge);
+        });
+    drop(ends);
 
     let tri_edges = tri_verts
         .par_iter()
@@ -516,52 +558,17 @@ fn group_uses(tri_verts: &[[VertId; 3]], vertex_count: usize) -> Grouped {
 /// saves.
 const PARALLEL_SIDES: usize = 1 << 16;
 
-/// One array of the parts' pieces one after another, then `closing` if there is one:
-/// `fill(i, part, piece)` writes part `i`'s piece of `len(part)` entries (`blank` until then),
-/// every part in parallel. Allocated once at its final size.
-fn side_by_side<T: Copy + Send>(
-    parts: &[Part],
-    (blank, closing): (T, Option<T>),
-    len: impl Fn(&Part) -> usize,
-    fill: impl Fn(usize, &Part, &mut [T]) + Sync,
-) -> Vec<T> {
-    let pieces_len: usize = parts.iter().map(&len).sum();
-    let mut out = vec![blank; pieces_len + usize::from(closing.is_some())];
-    if let Some(last) = closing {
-        out[pieces_len] = last;
-    }
-    let mut rest = &mut out[..];
-    let mut pieces = Vec::with_capacity(parts.len());
-    for p in parts {
-        let (piece, after) = rest.split_at_mut(len(p));
-        pieces.push(piece);
-        rest = after;
-    }
-    pieces
-        .into_par_iter()
-        .enumerate()
-        .for_each(|(i, piece)| fill(i, &parts[i], piece));
-    out
-}
-
-/// An offset array of every part side by side, each part's offsets shifted by what comes before
-/// it (`base`), closed by `end`.
-fn offsets_side_by_side(
-    parts: &[Part],
-    offsets: fn(&Part) -> &Vec<u32>,
-    base: &[usize],
-    end: usize,
-) -> Vec<u32> {
-    side_by_side(
-        parts,
-        (0, Some(end as u32)),
-        |p| offsets(p).len(),
-        |i, p, out| {
-            for (o, &x) in out.iter_mut().zip(offsets(p)) {
-                *o = base[i] as u32 + x;
-            }
-        },
-    )
+/// `whole` cut into consecutive pieces of the given lengths (which sum to at most its length).
+fn pieces_of<'a, T>(whole: &'a mut [T], lengths: &[usize]) -> Vec<&'a mut [T]> {
+    let mut rest = whole;
+    lengths
+        .iter()
+        .map(|&len| {
+            let (piece, after) = std::mem::take(&mut rest).split_at_mut(len);
+            rest = after;
+            piece
+        })
+        .collect()
 }
 
 /// The end points of a side, smaller first.
@@ -569,72 +576,109 @@ fn ordered(a: VertId, b: VertId) -> (VertId, VertId) {
     (a.min(b), a.max(b))
 }
 
-/// The sides whose smaller end point lies in one range of vertices, grouped into edges.
-struct Part {
-    /// `(larger end point << 32) | use` per side, by smaller end point, then larger, then use.
-    sides: Vec<u64>,
-    /// Per edge of the range: its end points.
-    edge_verts: Vec<[VertId; 2]>,
-    /// Per edge of the range: where its uses start in `sides`.
-    use_start: Vec<u32>,
-    /// Per vertex of the range: its first edge (edges of vertex `v` are up to the next vertex's).
-    first_edge: Vec<u32>,
+/// Side `k` of triangle `t` when its smaller end point lies in `range`: (that end point's place
+/// in the range, the larger end point).
+fn side_in(
+    tri_verts: &[[VertId; 3]],
+    range: &Range<usize>,
+    t: usize,
+    k: usize,
+) -> Option<(usize, VertId)> {
+    let v = tri_verts[t];
+    let (a, b) = ordered(v[(k + 1) % 3], v[(k + 2) % 3]);
+    let i = (a.0 as usize).wrapping_sub(range.start);
+    (i < range.len()).then_some((i, b))
 }
 
-impl Part {
-    fn of(tri_verts: &[[VertId; 3]], range: Range<usize>) -> Part {
-        let n = range.len();
-        let local = |t: usize, k: usize| {
-            let v = tri_verts[t];
-            let (a, b) = ordered(v[(k + 1) % 3], v[(k + 2) % 3]);
-            let i = (a.0 as usize).wrapping_sub(range.start);
-            (i < n).then_some((i, b))
-        };
-        // Bucket ends by smaller end point, then filled backwards: `start[i]` ends as the
-        // start of vertex i's bucket, `start[n]` as the count.
-        let mut start = vec![0u32; n + 1];
-        for t in 0..tri_verts.len() {
-            for k in 0..3 {
-                if let Some((i, _)) = local(t, k) {
-                    start[i] += 1;
-                }
+/// Where each vertex's bucket starts among the sides whose smaller end point lies in `range`:
+/// entry `i` for the range's vertex `i`, and a last entry with the range's side count.
+fn bucket_starts(tri_verts: &[[VertId; 3]], range: Range<usize>) -> Vec<u32> {
+    let n = range.len();
+    let mut start = vec![0u32; n + 1];
+    for t in 0..tri_verts.len() {
+        for k in 0..3 {
+            if let Some((i, _)) = side_in(tri_verts, &range, t, k) {
+                start[i + 1] += 1;
             }
         }
-        let mut sum = 0;
-        for x in &mut start[..n] {
-            sum += *x;
-            *x = sum;
-        }
-        start[n] = sum;
-        let mut sides = vec![0u64; sum as usize];
-        for t in 0..tri_verts.len() {
-            for k in 0..3 {
-                if let Some((i, b)) = local(t, k) {
-                    start[i] -= 1;
-                    sides[start[i] as usize] = (u64::from(b.0) << 32) | (3 * t + k) as u64;
-                }
+    }
+    let mut sum = 0;
+    for x in &mut start[1..] {
+        sum += *x;
+        *x = sum;
+    }
+    start
+}
+
+/// Puts the sides of `range` into their buckets (`start` from [`bucket_starts`]): each side's use
+/// into `uses` and its larger end point into `ends`, every bucket sorted by (larger end point,
+/// use). Returns how many edges the range has.
+fn fill_buckets(
+    tri_verts: &[[VertId; 3]],
+    range: Range<usize>,
+    start: &[u32],
+    uses: &mut [EdgeUse],
+    ends: &mut [u32],
+) -> usize {
+    let mut next = start[..range.len()].to_vec();
+    for t in 0..tri_verts.len() {
+        for k in 0..3 {
+            if let Some((i, b)) = side_in(tri_verts, &range, t, k) {
+                let at = next[i] as usize;
+                next[i] += 1;
+                uses[at] = EdgeUse((3 * t + k) as u32);
+                ends[at] = b.0;
             }
         }
-        let mut edge_verts = Vec::new();
-        let mut use_start = Vec::new();
-        let mut first_edge = Vec::with_capacity(n);
-        for i in 0..n {
-            first_edge.push(edge_verts.len() as u32);
-            let (from, to) = (start[i] as usize, start[i + 1] as usize);
-            let bucket = &mut sides[from..to];
-            bucket.sort_unstable();
-            for (j, &x) in bucket.iter().enumerate() {
-                if j == 0 || x >> 32 != bucket[j - 1] >> 32 {
-                    edge_verts.push([VertId((range.start + i) as u32), VertId((x >> 32) as u32)]);
-                    use_start.push((from + j) as u32);
+    }
+    drop(next);
+    // Each bucket as `(larger end << 32) | use`, sorted as plain integers.
+    let mut bucket = Vec::new();
+    let mut edges = 0;
+    for w in start.windows(2) {
+        let (from, to) = (w[0] as usize, w[1] as usize);
+        bucket.clear();
+        bucket.extend((from..to).map(|p| (u64::from(ends[p]) << 32) | u64::from(uses[p].0)));
+        bucket.sort_unstable();
+        for (j, &x) in bucket.iter().enumerate() {
+            if j == 0 || x >> 32 != bucket[j - 1] >> 32 {
+                edges += 1;
+            }
+            ends[from + j] = (x >> 32) as u32;
+            uses[from + j] = EdgeUse(x as u32);
+        }
+    }
+    edges
+}
+
+/// One range's sorted buckets, and where its uses and edges sit in the whole arrays.
+struct RangeEdges<'a> {
+    vertices: Range<usize>,
+    /// From [`bucket_starts`].
+    buckets: &'a [u32],
+    /// The range's larger end points, sorted within each bucket by [`fill_buckets`].
+    ends: &'a [u32],
+    /// The range's first use and first edge in the whole arrays.
+    first_use: u32,
+    first_edge: u32,
+}
+
+impl RangeEdges<'_> {
+    /// Writes the range's pieces of the edge arrays: each edge's end points and first use, and
+    /// each vertex's first edge. An edge starts wherever the larger end point changes within a
+    /// bucket.
+    fn write(&self, edge_verts: &mut [[VertId; 2]], use_start: &mut [u32], first_edge: &mut [u32]) {
+        let mut e = 0;
+        for (i, w) in self.buckets.windows(2).enumerate() {
+            first_edge[i] = self.first_edge + e as u32;
+            let a = VertId((self.vertices.start + i) as u32);
+            for p in w[0] as usize..w[1] as usize {
+                if p == w[0] as usize || self.ends[p] != self.ends[p - 1] {
+                    edge_verts[e] = [a, VertId(self.ends[p])];
+                    use_start[e] = self.first_use + p as u32;
+                    e += 1;
                 }
             }
-        }
-        Part {
-            sides,
-            edge_verts,
-            use_start,
-            first_edge,
         }
     }
 }
@@ -654,24 +698,31 @@ fn is_degenerate(v: &[VertId; 3], positions: &[DVec3]) -> bool {
 }
 
 /// Whether the triangles using an edge (`verts`, `tris`) disagree on the input normal at
-/// either end point.
+/// either end point; each use's triangle is read once for both end points.
 fn has_split_normals(
     verts: [VertId; 2],
     tris: &[EdgeUse],
     mesh: &TriMesh,
     tri_verts: &[[VertId; 3]],
 ) -> bool {
-    verts.iter().any(|&v| {
-        let mut normals = tris.iter().filter_map(|u| {
-            let t = u.tri().0 as usize;
-            let corner = tri_verts[t].iter().position(|&c| c == v)?;
-            Some(mesh.normals[mesh.triangles[t][corner] as usize])
-        });
-        match normals.next() {
-            Some(first) => normals.any(|n| n != first),
-            None => false,
+    // The first normal seen at each end point.
+    let mut first: [Option<DVec3>; 2] = [None; 2];
+    for u in tris {
+        let t = u.tri().0 as usize;
+        let (welded, input) = (tri_verts[t], mesh.triangles[t]);
+        for (seen, v) in first.iter_mut().zip(verts) {
+            let Some(corner) = welded.iter().position(|&c| c == v) else {
+                continue;
+            };
+            let n = mesh.normals[input[corner] as usize];
+            match seen {
+                None => *seen = Some(n),
+                Some(f) if *f != n => return true,
+                Some(_) => {}
+            }
         }
-    })
+    }
+    false
 }
 
 #[cfg(test)]
@@ -883,6 +934,30 @@ pub(crate) mod tests {
                     assert_eq!(n.slots[2], other.corner());
                 }
             }
+        }
+    }
+
+    #[test]
+    fn the_weld_does_not_depend_on_the_hash_of_the_positions() {
+        // Hashes that collide for every position, or for half of them, give the weld that the
+        // position bits alone give (the reference numbers positions by first use).
+        for seed in 0..20 {
+            let mut mesh = odd_mesh(seed, 40);
+            mesh.positions
+                .extend((0..200).map(|i| DVec3::new(f64::from(i % 7), -0.0, f64::from(i % 5))));
+            let (welded, _) = reference(&mesh);
+            let want = weld(&mesh.positions);
+            assert_eq!(want.0, welded, "seed {seed}");
+            let first = |w: &[VertId]| -> Vec<DVec3> {
+                let mut at = vec![None; w.iter().map(|v| v.0 as usize + 1).max().unwrap_or(0)];
+                for (i, v) in w.iter().enumerate() {
+                    at[v.0 as usize].get_or_insert(mesh.positions[i]);
+                }
+                at.into_iter().map(Option::unwrap).collect()
+            };
+            assert_eq!(want.1, first(&want.0));
+            assert_eq!(weld_by(&mesh.positions, |_| 7), want, "seed {seed}");
+            assert_eq!(weld_by(&mesh.positions, |b| b[0] & 1), want, "seed {seed}");
         }
     }
 

@@ -8,12 +8,17 @@
 //! written). It deliberately reports one line per kind, with the first few triangles or vertices
 //! as examples, so that a scan of a million bad triangles gives a readable report.
 
+use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::warning::Warning;
 use crate::mesh::TriMesh;
-use crate::topology::{EdgeId, EdgeKind, EdgeUse, Topology};
+use crate::topology::{EdgeId, EdgeKind, Topology, TriId};
+
+mod union_find;
+use union_find::UnionFind;
 
 /// Triangles whose smallest angle is below this (in radians, about 0.06°) are slivers: valid,
 /// but their normals and parameterization are numerically fragile.
@@ -66,13 +71,16 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         });
     }
 
-    let mut used = vec![false; mesh.positions.len()];
-    for t in &mesh.triangles {
+    // Every store writes `true`, so the order the threads run in does not matter.
+    let used: Vec<AtomicBool> = (0..mesh.positions.len())
+        .map(|_| AtomicBool::new(false))
+        .collect();
+    mesh.triangles.par_iter().for_each(|t| {
         for &c in t {
-            used[c as usize] = true;
+            used[c as usize].store(true, Relaxed);
         }
-    }
-    let unused = Tally::of(used.len(), |v| !used[v]);
+    });
+    let unused = Tally::of(used.len(), |v| !used[v].load(Relaxed));
     drop(used);
     if unused.count > 0 {
         out.push(Warning::UnusedVertices {
@@ -121,9 +129,7 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         });
     }
 
-    // One union-find buffer serves both connectivity passes.
-    let mut parent = Vec::new();
-    let bow_ties = bow_tie_vertices(topo, &mut parent);
+    let bow_ties = bow_tie_vertices(topo);
     if bow_ties.count > 0 {
         out.push(Warning::BowTieVertices {
             mesh: index,
@@ -132,7 +138,7 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         });
     }
 
-    let pieces = pieces(topo, &mut parent);
+    let pieces = pieces(topo);
     if pieces > MANY_PIECES {
         out.push(Warning::ManyPieces {
             mesh: index,
@@ -268,16 +274,24 @@ fn duplicate_triangles(topo: &Topology) -> Tally {
         let largest = v.iter().position(|x| x.0 == key[2]).unwrap_or(0);
         Some(topo.edge_uses(topo.tri_edges[t][largest]))
     };
+    // Whether any triangle chose a crowded edge: on most meshes none does, and the pass that
+    // sorts their triangles is skipped.
+    let crowded_seen = AtomicBool::new(false);
     let mut found = Tally::of(topo.tri_verts.len(), |t| {
         let key = corners(t);
         chosen(t, &key).is_some_and(|uses| {
-            uses.len() <= CROWDED
-                && uses
-                    .iter()
-                    .take_while(|u| (u.tri().0 as usize) < t)
-                    .any(|u| corners(u.tri().0 as usize) == key)
+            if uses.len() > CROWDED {
+                crowded_seen.store(true, Relaxed);
+                return false;
+            }
+            uses.iter()
+                .take_while(|u| (u.tri().0 as usize) < t)
+                .any(|u| corners(u.tri().0 as usize) == key)
         })
     });
+    if !crowded_seen.load(Relaxed) {
+        return found;
+    }
     let mut crowded: Vec<([u32; 3], u32)> = (0..topo.tri_verts.len())
         .into_par_iter()
         .filter_map(|t| {
@@ -297,13 +311,14 @@ fn duplicate_triangles(topo: &Topology) -> Tally {
 
 /// Do both triangles of interior edge `e` run along it in the same direction (one of them is
 /// wound the other way)?
+///
+/// Read from the first triangle's neighbour: its edge runs from its corner i to its corner j,
+/// and the neighbour's edge from its slot `r + 1` to `r + 2`, so both run the same way exactly
+/// when the neighbour holds i in slot `r + 1` (no triangle lookup needed).
 fn same_direction(topo: &Topology, e: usize) -> bool {
-    let edge = topo.edge(EdgeId(e as u32));
-    let dir = |u: EdgeUse| {
-        let (t, k) = u.at();
-        topo.tri_verts[t][(k + 1) % 3] == edge.verts[0]
-    };
-    dir(edge.tris[0]) == dir(edge.tris[1])
+    let (t, k) = topo.edge_uses(EdgeId(e as u32))[0].at();
+    topo.neighbour(TriId(t as u32), k)
+        .is_some_and(|n| n.slots[0] == (n.slots[2] + 1) % 3)
 }
 
 /// Welded vertices whose triangles form more than one fan (connected through edges that contain
@@ -314,20 +329,20 @@ fn same_direction(topo: &Topology, e: usize) -> bool {
 /// all its triangles at each of its end points, straight from its uses. Walking edges rather than
 /// triangles keeps this linear in the corners whatever the valence (a book of 100 000 triangles
 /// on one edge, or 100 000 copies of one triangle), where joining per triangle and edge use was
-/// cubic in it. A vertex is a bow-tie when its corners fall into two or more classes.
-fn bow_tie_vertices(topo: &Topology, parent: &mut Vec<u32>) -> Tally {
+/// cubic in it. The edges are joined in parallel ([`UnionFind`]). A vertex is a bow-tie when its
+/// corners fall into two or more classes.
+fn bow_tie_vertices(topo: &Topology) -> Tally {
     // The corner of `t` holding the welded vertex of its corner `c`: the first with it.
     let canonical = |t: usize, c: usize| {
         let v = topo.tri_verts[t];
         let first = v.iter().position(|&x| x == v[c]).unwrap_or(c);
         (3 * t + first) as u32
     };
-    parent.clear();
-    parent.extend(0..3 * topo.tri_verts.len() as u32);
-    for e in 0..topo.edge_count() {
+    let corners = UnionFind::new(3 * topo.tri_verts.len() as u32);
+    (0..topo.edge_count()).into_par_iter().for_each(|e| {
         let uses = topo.edge_uses(EdgeId(e as u32));
         let Some((&head, rest)) = uses.split_first() else {
-            continue;
+            return;
         };
         let (t0, k0) = head.at();
         for end in [1, 2] {
@@ -340,50 +355,42 @@ fn bow_tie_vertices(topo: &Topology, parent: &mut Vec<u32>) -> Tally {
                 } else {
                     (k + 3 - end) % 3
                 };
-                union(parent, anchor, canonical(t, c));
+                corners.union(anchor, canonical(t, c));
             }
         }
-    }
-    // Classes per welded vertex: its canonical corners that are roots (saturating at 2).
-    let mut classes = vec![0u8; topo.welded_positions.len()];
-    for t in 0..topo.tri_verts.len() {
+    });
+    // A vertex is a bow-tie when two of its canonical corners are roots (the smallest corner of
+    // each class): the first root marks the vertex seen, any later one marks it a bow-tie.
+    let blank = || -> Vec<AtomicBool> {
+        (0..topo.welded_positions.len())
+            .map(|_| AtomicBool::new(false))
+            .collect()
+    };
+    let (seen, bow_tie) = (blank(), blank());
+    (0..topo.tri_verts.len()).into_par_iter().for_each(|t| {
         for c in 0..3 {
             let corner = (3 * t + c) as u32;
-            if canonical(t, c) == corner && root(parent, corner) == corner {
-                let n = &mut classes[topo.tri_verts[t][c].0 as usize];
-                *n = n.saturating_add(1);
+            if canonical(t, c) == corner && corners.is_root(corner) {
+                let v = topo.tri_verts[t][c].0 as usize;
+                if seen[v].swap(true, Relaxed) {
+                    bow_tie[v].store(true, Relaxed);
+                }
             }
         }
-    }
-    Tally::of(classes.len(), |v| classes[v] > 1)
+    });
+    Tally::of(bow_tie.len(), |v| bow_tie[v].load(Relaxed))
 }
 
-/// Connected pieces of triangles (through welded edges).
-fn pieces(topo: &Topology, parent: &mut Vec<u32>) -> usize {
+/// Connected pieces of triangles (through welded edges), joined in parallel.
+fn pieces(topo: &Topology) -> usize {
     let n = topo.tri_verts.len() as u32;
-    parent.clear();
-    parent.extend(0..n);
-    for e in 0..topo.edge_count() {
+    let tris = UnionFind::new(n);
+    (0..topo.edge_count()).into_par_iter().for_each(|e| {
         for w in topo.edge_uses(EdgeId(e as u32)).windows(2) {
-            union(parent, w[0].tri().0, w[1].tri().0);
+            tris.union(w[0].tri().0, w[1].tri().0);
         }
-    }
-    (0..n).filter(|&i| root(parent, i) == i).count()
-}
-
-/// Joins the classes of `a` and `b`, the larger root under the smaller.
-fn union(p: &mut [u32], a: u32, b: u32) {
-    let (a, b) = (root(p, a), root(p, b));
-    p[a.max(b) as usize] = a.min(b);
-}
-
-/// The root of `i` in the union-find forest `p`, halving the path on the way.
-fn root(p: &mut [u32], mut i: u32) -> u32 {
-    while p[i as usize] != i {
-        p[i as usize] = p[p[i as usize] as usize];
-        i = p[i as usize];
-    }
-    i
+    });
+    (0..n).into_par_iter().filter(|&i| tris.is_root(i)).count()
 }
 
 #[cfg(test)]
@@ -439,7 +446,7 @@ mod tests {
             let mesh = odd_mesh(seed, 8 + 5 * seed as usize);
             let topo = Topology::build(&mesh);
             let want = bow_ties_by_search(&topo);
-            let got = bow_tie_vertices(&topo, &mut Vec::new());
+            let got = bow_tie_vertices(&topo);
             assert_eq!(got.count, want.len(), "seed {seed}");
             assert_eq!(got.examples(), &want[..want.len().min(EXAMPLES)]);
 
@@ -457,6 +464,69 @@ mod tests {
             let got = duplicate_triangles(&topo);
             assert_eq!(got.count, copies.len(), "seed {seed}");
             assert_eq!(got.examples(), &copies[..copies.len().min(EXAMPLES)]);
+        }
+    }
+
+    /// Pieces the slow way: a search from each unvisited triangle through the triangles that
+    /// share a welded edge with it.
+    fn pieces_by_search(topo: &Topology) -> usize {
+        let n = topo.tri_verts.len();
+        let mut seen = vec![false; n];
+        let mut pieces = 0;
+        for s in 0..n {
+            if seen[s] {
+                continue;
+            }
+            pieces += 1;
+            seen[s] = true;
+            let mut stack = vec![s];
+            while let Some(t) = stack.pop() {
+                for e in topo.tri_edges[t] {
+                    for u in topo.edge_uses(e) {
+                        let g = u.tri().0 as usize;
+                        if !seen[g] {
+                            seen[g] = true;
+                            stack.push(g);
+                        }
+                    }
+                }
+            }
+        }
+        pieces
+    }
+
+    #[test]
+    fn bow_ties_and_pieces_match_the_slow_definitions_on_any_thread_count() {
+        for seed in 0..12 {
+            // Odd shapes, and many small pieces of them (the same triangles shifted apart).
+            let mut mesh = odd_mesh(seed, 200 + 150 * seed as usize);
+            let (count, tris) = (mesh.positions.len() as u32, mesh.triangles.clone());
+            for shift in 1..4 {
+                let moved: Vec<DVec3> = mesh.positions[..count as usize]
+                    .iter()
+                    .map(|p| *p + DVec3::splat(10.0 * f64::from(shift)))
+                    .collect();
+                mesh.positions.extend(moved);
+                mesh.normals.extend_from_within(..count as usize);
+                mesh.triangles.extend(
+                    tris.iter()
+                        .step_by(shift as usize + 1)
+                        .map(|t| t.map(|v| v + shift * count)),
+                );
+            }
+            let topo = Topology::build(&mesh);
+            let want = bow_ties_by_search(&topo);
+            let pieces_want = pieces_by_search(&topo);
+            for threads in [1, 2, 3, 8] {
+                let (got, pieces_got) = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| (bow_tie_vertices(&topo), pieces(&topo)));
+                assert_eq!(got.count, want.len(), "seed {seed}, {threads} threads");
+                assert_eq!(got.examples(), &want[..want.len().min(EXAMPLES)]);
+                assert_eq!(pieces_got, pieces_want, "seed {seed}, {threads} threads");
+            }
         }
     }
 
