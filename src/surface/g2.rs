@@ -8,18 +8,14 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::blend::neighbour_map;
+use super::neighbour_net::{compose_across, Reach, SoaNet};
 use super::nets::Nets;
 use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights, LANES};
-use super::pn::{compose, Net, B111, NEAR};
+use super::pn::{Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::sharpness::EffectiveH;
 use crate::topology::{Edge, EdgeId, Topology, TriId};
-
-/// A control net by coordinate, `[x, y, z][control point]`: the layout the per-point sums of
-/// [`accumulate`] read, one coordinate of one control point at a time.
-type SoaNet = [[f64; 10]; 3];
 
 /// Everything one triangle needs at evaluation time that the mesh and its topology do not
 /// already hold: 88 bytes, one allocation for the whole mesh.
@@ -213,21 +209,23 @@ impl<'a> G2Surface<'a> {
     }
 
     /// The neighbour's net across edge `k` of triangle `tri` in `tri`'s barycentrics,
-    /// `b_g ∘ M` (Eq. 3 in the form of [`neighbour_map`]); `k` must be a blended edge.
+    /// `b_g ∘ M` (Eq. 3 in the form of [`neighbour_map`](super::blend::neighbour_map)); `k`
+    /// must be a blended edge. With `reach` [`Reach::Edge`] only the seven control points a
+    /// point on edge `k` itself weighs are composed (see [`compose_across`]).
     ///
     /// The composed nets are not stored: three of them per triangle were two thirds of the
     /// surface's memory (720 of 1128 bytes), more than the dense output of a level-8 triangle,
     /// and composing costs less than the page faults of holding them. Each is composed once per
     /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
     /// still agree bit for bit.
-    fn across_net(&self, tri: usize, k: usize) -> SoaNet {
+    fn across_net(&self, tri: usize, k: usize, reach: Reach) -> SoaNet {
         debug_assert!(self.widths(tri)[k] > 0.0, "only blended edges");
         let n = self
             .topo
             .neighbour(TriId(tri as u32), k)
             .expect("blended edges are interior");
-        let g = aos(&self.local(n.tri.0 as usize).net);
-        soa(&compose(&g, neighbour_map(k, n.slots.map(usize::from))))
+        let g = self.local(n.tri.0 as usize).net;
+        compose_across(&g, k, n.slots.map(usize::from), reach)
     }
 
     /// Triangle `tri`'s whole net and corner normals, exactly as they were when its net was
@@ -324,11 +322,6 @@ fn accumulate<const L: usize>(
         }
     }
     acc
-}
-
-/// A net by coordinate.
-fn soa(net: &Net) -> SoaNet {
-    [0, 1, 2].map(|c| net.map(|p| p[c]))
 }
 
 /// A net by control point (the inverse of [`soa`], bit for bit).
@@ -461,7 +454,8 @@ impl PointEvaluation {
         let tri = self.tri;
         let net = w.blended.then(|| {
             let k = w.k as usize;
-            &*self.across[k].get_or_insert_with(|| broadcast(&surface.across_net(tri, k)))
+            &*self.across[k]
+                .get_or_insert_with(|| broadcast(&surface.across_net(tri, k, Reach::Whole)))
         });
         let [p] = G2Surface::combine(&self.local.normal, &Lanes::<1>::single(&w), &self.own, net);
         p
@@ -488,19 +482,20 @@ impl Surface for G2Surface<'_> {
         part: LatticePart,
         out: &mut Vec<SurfacePoint>,
     ) {
-        PartEvaluation::new(self, tri).part(level, part, out);
+        PartEvaluation::new(self, tri, &[(level, part)]).part(level, part, out);
     }
 
     /// [`Surface::evaluate_lattice_part`] part after part, with the triangle's own net rebuilt
     /// and broadcast once, and each neighbour's net composed (Eq. 3) once for every part that
-    /// blends across its edge (an edge and the interior both do), instead of once per part.
+    /// blends across its edge (an edge and the interior both do), instead of once per part;
+    /// only its edge row when the parts are all edges.
     fn evaluate_lattice_parts(
         &self,
         tri: usize,
         parts: &[(u32, LatticePart)],
         out: &mut Vec<SurfacePoint>,
     ) {
-        let mut evaluation = PartEvaluation::new(self, tri);
+        let mut evaluation = PartEvaluation::new(self, tri, parts);
         for &(level, part) in parts {
             evaluation.part(level, part, out);
         }
@@ -517,12 +512,17 @@ struct PartEvaluation<'s, 'a> {
     widths: [f64; 3],
     local: Local,
     own: Broadcast<LANES>,
-    across: [Option<Broadcast<LANES>>; 3],
+    /// Each neighbour's composed net, and how much of it was composed.
+    across: [Option<(Reach, Broadcast<LANES>)>; 3],
+    /// Whether every part asked for is an edge: then a neighbour's net is only ever weighed on
+    /// its own edge, and its edge row is all that is composed ([`Reach::Edge`]).
+    edges_only: bool,
 }
 
 impl<'s, 'a> PartEvaluation<'s, 'a> {
+    /// The set-up for the lattice parts `parts` of triangle `tri`.
     #[inline]
-    fn new(surface: &'s G2Surface<'a>, tri: usize) -> Self {
+    fn new(surface: &'s G2Surface<'a>, tri: usize, parts: &[(u32, LatticePart)]) -> Self {
         let local = surface.local(tri);
         PartEvaluation {
             surface,
@@ -531,6 +531,9 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
             own: broadcast(&local.net),
             local,
             across: [None; 3],
+            edges_only: parts
+                .iter()
+                .all(|&(_, part)| matches!(part, LatticePart::Edge(_))),
         }
     }
 
@@ -544,6 +547,7 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
             local,
             own,
             across,
+            edges_only,
         } = self;
         surface
             .patterns
@@ -570,7 +574,20 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                         continue;
                     }
                     let across = k.map(|k| {
-                        &*across[k].get_or_insert_with(|| broadcast(&surface.across_net(*tri, k)))
+                        // Points of edge k blend only across edge k; any other part may weigh
+                        // the whole net.
+                        let reach = if *edges_only && part == LatticePart::Edge(k as u8) {
+                            Reach::Edge
+                        } else {
+                            Reach::Whole
+                        };
+                        let cached = &mut across[k];
+                        if !matches!(*cached, Some((had, _)) if had == Reach::Whole || had == reach)
+                        {
+                            let net = surface.across_net(*tri, k, reach);
+                            *cached = Some((reach, broadcast(&net)));
+                        }
+                        &cached.as_ref().expect("composed just above").1
                     });
                     for lanes in blocks {
                         let points = G2Surface::combine(&local.normal, lanes, own, across);

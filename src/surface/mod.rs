@@ -31,13 +31,16 @@
 //! Bernstein basis, composition), [`profile`] (r(s)), [`blend`] (subdomain,
 //! t, β, neighbour map), [`pattern`] (geometry-free per-point weights, cached per lattice in a
 //! [`lattice_cache`], as the other schemes' lattice weights are), and
-//! `g2.rs` ([`G2Surface`], [`PnSurface`]: nets per triangle, combination, normals).
+//! `g2.rs` ([`G2Surface`], [`PnSurface`]: nets per triangle, combination, normals), with
+//! `neighbour_net.rs` (the neighbour's net in the triangle's own barycentrics, Eq. 3, computed
+//! as `pn::compose` computes it but with only the arithmetic that can change a bit).
 
 pub mod blend;
 pub mod coons;
 mod g2;
 pub mod hybrid;
 pub mod lattice_cache;
+mod neighbour_net;
 pub mod nets;
 pub mod pattern;
 pub mod pn;
