@@ -453,6 +453,21 @@ impl Document {
         Ok((data, start..end))
     }
 
+    /// Frees the bytes of every buffer read with the document (the input's buffers, and the
+    /// scratch buffer holding its decoded meshopt views), keeping the arrays the pipeline
+    /// stored since. For a streamed output once the primitives are decoded: the input's bytes
+    /// the output keeps are on disk by then and the rest are the replaced primitives', so
+    /// holding them to the end (a large scan's whole file) only raises the peak. A view of a
+    /// freed buffer reads as out of range afterwards (an error, never stale bytes); new views
+    /// are appended to the emptied scratch buffer from its start.
+    pub(crate) fn release_read_buffers(&mut self) {
+        for (data, buffer) in self.buffers.iter_mut().zip(&self.root.buffers) {
+            if buffer.name.as_deref() != Some(ARRAY_BUFFER_NAME) {
+                *data = Arc::default();
+            }
+        }
+    }
+
     /// Bytes held in all buffers.
     pub(crate) fn buffer_bytes(&self) -> u64 {
         self.buffers.iter().map(|b| b.len() as u64).sum()

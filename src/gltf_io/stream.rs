@@ -131,6 +131,14 @@ impl StreamedOutput {
         Ok(out)
     }
 
+    /// Frees the buffers `doc` was read with, once its triangle primitives are decoded: every
+    /// input view the output keeps was written (or compared) by [`StreamedOutput::begin`], and
+    /// what remains of them belonged to the primitives being replaced. On a million-triangle
+    /// scan that is the whole input file, held otherwise until the end.
+    pub fn release_input(&self, doc: &mut Document) {
+        doc.release_read_buffers();
+    }
+
     /// Writes every buffer view added to `doc` since the last call, in order, and frees the
     /// arrays that held them. `last`: no view will be added after these; a `.glb` then keeps
     /// them in memory and writes them behind the staged binary data at the end, since staging
@@ -315,6 +323,11 @@ mod tests {
 
     /// One triangle, its positions in a `data:` buffer.
     fn triangle() -> Document {
+        triangle_and(&[])
+    }
+
+    /// [`triangle`] with the primitives `more` after it in its mesh.
+    fn triangle_and(more: &[serde_json::Value]) -> Document {
         let floats: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
             .iter()
             .flat_map(|x| x.to_le_bytes())
@@ -331,6 +344,11 @@ mod tests {
                             "min": [0, 0, 0], "max": [1, 1, 0] }],
             "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 } }] }],
         });
+        let mut json = json;
+        json["meshes"][0]["primitives"]
+            .as_array_mut()
+            .unwrap()
+            .extend_from_slice(more);
         read_bytes(
             &serde_json::to_vec(&json).unwrap(),
             None,
@@ -443,6 +461,32 @@ mod tests {
             after < 1 << 20,
             "{after} bytes of the staged data still allocated"
         );
+    }
+
+    /// Once the primitives are decoded the input's bytes are freed, and the output still holds
+    /// every input view it keeps (here the positions, which a line primitive also draws):
+    /// they were written when the output began.
+    #[test]
+    fn released_input_bytes_are_freed_and_the_views_kept_are_still_written() {
+        let lines = serde_json::json!({ "attributes": { "POSITION": 0 }, "mode": 1 });
+        let with_lines = || triangle_and(std::slice::from_ref(&lines));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.glb");
+        let opts = WriteOptions::default();
+        let mut in_memory = with_lines();
+        replace_primitive_owned(&mut in_memory, 0, 0, strip(1000)).unwrap();
+        let expected = write::encode(&in_memory, &path, &opts).unwrap();
+
+        let mut doc = with_lines();
+        let mut out =
+            StreamedOutput::begin(&doc, &path, &opts, &[(0, 0)], StreamMode::Write).unwrap();
+        assert_eq!(doc.buffer_bytes(), 36);
+        out.release_input(&mut doc);
+        assert_eq!(doc.buffer_bytes(), 0);
+        replace_primitive_owned(&mut doc, 0, 0, strip(1000)).unwrap();
+        out.flush(&mut doc, true).unwrap();
+        out.finish(&doc).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), expected[0].to_bytes());
     }
 
     #[test]

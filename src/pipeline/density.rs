@@ -13,7 +13,8 @@ use crate::mesh::TriMesh;
 use crate::options::Options;
 use crate::surface::Surface;
 use crate::tessellate::{
-    chord_error, tessellate, tessellate_with_counts, ChordErrors, DenseMesh, SegmentCounts,
+    chord_error, tessellate_vertices, tessellate_with_counts, ChordErrors, DenseMesh,
+    SegmentCounts, Tessellation,
 };
 use crate::topology::Topology;
 
@@ -96,33 +97,37 @@ impl Density {
         }
     }
 
-    /// Tessellates `groups` at this density.
-    pub fn tessellate(
+    /// Tessellates `groups` at this density; what is left once the surface may be freed is
+    /// written by [`Tessellation::finish`].
+    pub fn tessellate<'a>(
         &self,
-        mesh: &TriMesh,
+        mesh: &'a TriMesh,
         topo: &Topology,
         h: &[f64],
         surface: &dyn Surface,
         groups: &[Range<usize>],
-    ) -> Vec<DenseMesh> {
+    ) -> Tessellation<'a> {
         match self {
-            Density::Level(level) => tessellate(mesh, topo, h, surface, *level, groups),
-            Density::Counts { counts, .. } => {
-                tessellate_with_counts(mesh, topo, h, surface, counts, groups)
-            }
+            Density::Level(level) => tessellate_vertices(mesh, topo, h, surface, *level, groups),
+            Density::Counts { counts, .. } => Tessellation::done(tessellate_with_counts(
+                mesh, topo, h, surface, counts, groups,
+            )),
         }
     }
 
     /// The report's figures: always for per-edge counts; at a uniform level only when `measure`
-    /// (then the tolerance is the measured error), so uniform and adaptive runs compare.
+    /// (then the tolerance is the measured error), so uniform and adaptive runs compare. The
+    /// surface is read only to measure; without it nothing is measured.
     pub fn figures(
         &self,
         topo: &Topology,
-        surface: &dyn Surface,
+        surface: Option<&dyn Surface>,
         groups: &[Range<usize>],
         dense: &[DenseMesh],
         measure: bool,
     ) -> Option<AdaptiveFigures> {
+        let surface = surface.filter(|_| measure);
+        let measure = surface.is_some();
         let (counts, target) = match self {
             Density::Counts { counts, target } => (counts.clone(), Some(*target)),
             Density::Level(level) if measure => (SegmentCounts::uniform(topo, *level), None),
@@ -135,7 +140,7 @@ impl Density {
             min_angle = min_angle.min(a);
             max_aspect = max_aspect.max(r);
         }
-        let chord = measure.then(|| {
+        let chord = surface.map(|surface| {
             groups
                 .iter()
                 .zip(dense)

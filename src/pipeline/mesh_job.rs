@@ -231,8 +231,8 @@ pub fn smooth_mesh(
     // Every level written is held (and, with MSFT_lod, stored in the one file): the limit is
     // on their sum.
     let mut planned_total = 0u64;
-    // The G² surface holds about 112 bytes per input triangle: freed once the last level is
-    // tessellated, before its attributes are carried, when the dense mesh is at its largest.
+    // The G² surface holds about 88 bytes per input triangle: freed once the last level's
+    // vertices are evaluated, before its triangles are written and its attributes carried.
     let mut surface = Some(surface);
     let last = levels.len() - 1;
     for (k, level_options) in levels.iter().enumerate() {
@@ -271,10 +271,22 @@ pub fn smooth_mesh(
                 ),
             ));
         }
-        let mut dense = density.tessellate(&mesh, &topo, &effective, live, &groups);
+        let tessellation = density.tessellate(&mesh, &topo, &effective, live, &groups);
+        // Unless the report measures the output against it, the surface is done with before
+        // the output's triangles and vertex sources are written: they are not held together.
+        if k == last && !options.report_figures {
+            surface = None;
+        }
+        let mut dense = tessellation.finish();
         report.times.tessellate += tess_start.elapsed().as_secs_f64();
         // Measured for the report only, as for one level: the output never depends on it.
-        let figures = density.figures(&topo, live, &groups, &dense, options.report_figures);
+        let figures = density.figures(
+            &topo,
+            surface.as_deref(),
+            &groups,
+            &dense,
+            options.report_figures,
+        );
         if k == last {
             surface = None;
         }
@@ -375,6 +387,13 @@ fn refuse_non_finite(
         let Some(v) = a.floats() else {
             continue;
         };
+        // Every value of a dense mesh is checked: in parallel chunks, each by a branch-free
+        // fold the compiler vectorizes (a search that stops at the first hit is not), and the
+        // first bad value looked for only where there is one.
+        let finite = |c: &[f32]| c.iter().fold(true, |ok, x| ok & x.is_finite());
+        if v.par_chunks(1 << 16).all(finite) {
+            continue;
+        }
         if let Some(i) = v.iter().position(|x| !x.is_finite()) {
             return Err(gltf_io::Error::invalid(
                 format!("{at}.{target}attributes.{}", a.name),

@@ -96,8 +96,12 @@ fn stream_file(
         gltf_io::StreamedOutput::begin(&doc, output, &write, &doc.triangle_primitives(), mode)
             .map_err(at_output)?;
     let begin_s = begin_start.elapsed().as_secs_f64();
-    let mut report = smooth_meshes(&mut doc, input, options, &mut |doc, last| {
-        out.flush(doc, last).map_err(at_output)
+    let mut report = smooth_meshes(&mut doc, input, options, &mut |doc, step| match step {
+        Step::Decoded => {
+            out.release_input(doc);
+            Ok(())
+        }
+        Step::Stored { last } => out.flush(doc, last).map_err(at_output),
     })?;
     // A stop that came while the last mesh was written: the temporaries go, nothing is
     // renamed into place (the in-memory path in `process_file` checks at the same point).
@@ -220,16 +224,25 @@ pub fn process_document(
     smooth_meshes(doc, asset, options, &mut |_, _| Ok(()))
 }
 
-/// [`process_document`], calling `stored` after each mesh's new primitives are stored in
-/// `doc` (in file order; with `true` after the last), so that a writer can take their arrays
-/// out at once.
+/// A point of [`smooth_meshes`] at which a writer may act on the document.
+enum Step {
+    /// Every triangle primitive is decoded and none is smoothed yet: a writer that no longer
+    /// needs the input's bytes frees them before the surfaces are built.
+    Decoded,
+    /// A mesh's new primitives are stored in the document (in file order; `last` after the
+    /// last): a writer can take their arrays out at once.
+    Stored { last: bool },
+}
+
+/// [`process_document`], calling `step` at each [`Step`].
 fn smooth_meshes(
     doc: &mut Document,
     asset: &Path,
     options: &Options,
-    stored: &mut dyn FnMut(&mut Document, bool) -> Result<(), Error>,
+    step: &mut dyn FnMut(&mut Document, Step) -> Result<(), Error>,
 ) -> Result<FileReport, Error> {
     let (sharpness, mut report, inputs) = prepare_document(doc, asset, options)?;
+    step(doc, Step::Decoded)?;
     // The meshes are independent: smooth as many in parallel as there are threads, then store
     // them in file order. Only one such window of outputs (and of decoded inputs) is held at
     // a time, so a file of many large meshes never holds all their outputs at once.
@@ -251,7 +264,7 @@ fn smooth_meshes(
             let store_start = Instant::now();
             let mesh_report = lod::store_with_msft_lod(doc, out?, asset)?;
             left -= 1;
-            stored(doc, left == 0)?;
+            step(doc, Step::Stored { last: left == 0 })?;
             report.times.write += store_start.elapsed().as_secs_f64();
             report.add_mesh(mesh_report);
         }

@@ -57,7 +57,9 @@ pub fn targets(
         let moved = displaced(mesh, prepared, t);
         let (surface, said) = super::mesh_job::build_surface(options, &moved, topo, h);
         warnings.extend(said.into_iter().map(|w| (t, w)));
-        let dense = density.tessellate(&moved, topo, h, surface.as_ref(), groups);
+        let dense = density
+            .tessellate(&moved, topo, h, surface.as_ref(), groups)
+            .finish();
         for (k, d) in dense.into_iter().enumerate() {
             let (positions, normals) = match &remaps[k] {
                 Some(remap) => {

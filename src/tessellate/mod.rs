@@ -42,6 +42,14 @@
 //! allocation, no hash map, and the same bytes at any thread count. Triangles come out in
 //! cache-friendly bands and vertices in order of first use, so meshoptimizer's passes have
 //! little left to do (`optimize.rs` measures it).
+//!
+//! # Memory
+//!
+//! The uniform path writes a group in two halves: the vertices while the surface is needed
+//! ([`tessellate_vertices`]), then the triangles and the vertex sources from the numbering
+//! alone ([`Tessellation::finish`]), so that the pipeline frees the surface in between. On the
+//! 1M-triangle icosphere at level 2 that keeps the G² surface (88 MB) and the index and source
+//! buffers (64 MB) from being held at once: the heap's peak fell from 401 MB to 308 MB.
 
 mod adaptive;
 mod blocks;
@@ -175,15 +183,79 @@ pub fn tessellate(
     level: u32,
     groups: &[Range<usize>],
 ) -> Vec<DenseMesh> {
+    tessellate_vertices(mesh, topo, h, surface, level, groups).finish()
+}
+
+/// The first half of [`tessellate`]: every output vertex evaluated and written, the triangles
+/// and the vertex sources still to come ([`Tessellation::finish`]). Those depend on the
+/// numbering alone, not on the surface, so a caller that is done with the surface frees it
+/// in between: on a million-triangle input at level 2 the G² surface (88 bytes per input
+/// triangle) and the indices and sources (64 bytes per input triangle) are then never held at
+/// once.
+///
+/// # Panics
+/// As [`tessellate`].
+pub fn tessellate_vertices<'a>(
+    mesh: &'a TriMesh,
+    topo: &Topology,
+    h: &[f64],
+    surface: &dyn Surface,
+    level: u32,
+    groups: &[Range<usize>],
+) -> Tessellation<'a> {
     assert!(
         level <= MAX_TESSELLATION_LEVEL,
         "level {level} is above {MAX_TESSELLATION_LEVEL}"
     );
     let plan = LatticePlan::new(level.max(1));
-    groups
+    let groups = groups
         .par_iter()
         .map(|range| tessellate_group(mesh, topo, h, surface, &plan, range.clone()))
-        .collect()
+        .collect();
+    Tessellation {
+        meshes: Vec::new(),
+        numbering: Some(Numbering { mesh, plan, groups }),
+    }
+}
+
+/// A tessellation, possibly with only its vertices written (see [`tessellate_vertices`]).
+pub struct Tessellation<'a> {
+    /// The finished meshes, when nothing is left to write.
+    meshes: Vec<DenseMesh>,
+    /// What writes the rest of each group: its vertices written, its numbering kept.
+    numbering: Option<Numbering<'a>>,
+}
+
+/// The uniform path's groups between their two halves.
+struct Numbering<'a> {
+    mesh: &'a TriMesh,
+    plan: LatticePlan,
+    /// Per group: its first source triangle, its vertex numbering, its vertices.
+    groups: Vec<(usize, GroupLayout, DenseMesh)>,
+}
+
+impl Tessellation<'_> {
+    /// Meshes that are complete already (the per-edge-count path writes everything in one pass).
+    pub fn done(meshes: Vec<DenseMesh>) -> Self {
+        Tessellation {
+            meshes,
+            numbering: None,
+        }
+    }
+
+    /// The meshes, with their triangles and vertex sources written: no surface is read.
+    pub fn finish(self) -> Vec<DenseMesh> {
+        let Some(Numbering { mesh, plan, groups }) = self.numbering else {
+            return self.meshes;
+        };
+        groups
+            .into_par_iter()
+            .map(|(first_tri, layout, mut dense)| {
+                number_group(mesh, &plan, first_tri, &layout, &mut dense);
+                dense
+            })
+            .collect()
+    }
 }
 
 /// The triangle that evaluates the samples of welded edge `e` for everyone, and the corner its
@@ -241,6 +313,7 @@ struct Shared<'a> {
     first_tri: usize,
 }
 
+/// The vertices of one group, evaluated and written, with the numbering that places them.
 fn tessellate_group(
     mesh: &TriMesh,
     topo: &Topology,
@@ -248,34 +321,22 @@ fn tessellate_group(
     surface: &dyn Surface,
     plan: &LatticePlan,
     range: Range<usize>,
-) -> DenseMesh {
+) -> (usize, GroupLayout, DenseMesh) {
     let n = plan.n;
     let layout = GroupLayout::new(mesh, topo, h, n, plan.interior, range.clone());
     let vertex_count = layout.vertex_count();
-    let per_tri_indices = 3 * (n * n) as usize;
+    // The pages are zeroed by the kernel as they are first written, in parallel below.
     let mut out = DenseMesh {
         positions: vec![[0.0; 3]; vertex_count],
         normals: vec![[0.0; 3]; vertex_count],
-        sources: Vec::with_capacity(vertex_count),
-        indices: vec![0; range.len() * per_tri_indices],
+        sources: Vec::new(),
+        indices: Vec::new(),
     };
-    // Every slot is overwritten below; filling in parallel spreads the first touch of the
-    // pages (the other buffers are zeroed by the kernel as they are first written).
-    out.sources.par_extend(rayon::iter::repeat_n(
-        VertexSource::lattice(0, 1, 0, 0),
-        vertex_count,
-    ));
-
-    // Cut the buffers into per-block slices.
-    let tris_per_block = (BLOCK_TRIANGLES / (n * n) as usize).max(1);
-    let ranges = (0..range.len())
-        .step_by(tris_per_block)
-        .map(|start| start..(start + tris_per_block).min(range.len()));
     let blocks = blocks::split(
         &mut out,
-        ranges,
+        block_ranges(n, range.len()),
         |t| layout.base[t] as usize,
-        |t| t * per_tri_indices,
+        |_| 0,
     );
     let shared = Shared {
         mesh,
@@ -288,13 +349,125 @@ fn tessellate_group(
     blocks
         .into_par_iter()
         .for_each(|block| tessellate_block(&shared, block));
-    out
+    (range.start, layout, out)
 }
 
-/// Evaluates and writes the vertices a block owns and all its triangles. Each output vertex is
-/// evaluated once: corners are the input vertices, edge samples come from the shared pass (their
-/// normals too, unless this triangle is not the edge's evaluator), and only the interior is
-/// evaluated here.
+/// The blocks of a group of `len` source triangles at level `n`: consecutive triangle ranges
+/// of about [`BLOCK_TRIANGLES`] output triangles.
+fn block_ranges(n: u32, len: usize) -> impl Iterator<Item = Range<usize>> {
+    let tris_per_block = (BLOCK_TRIANGLES / (n * n) as usize).max(1);
+    (0..len)
+        .step_by(tris_per_block)
+        .map(move |start| start..(start + tris_per_block).min(len))
+}
+
+/// The second half of a group: its triangles and the source of every vertex, from the
+/// numbering alone (the same slots [`tessellate_block`] gave the writer).
+fn number_group(
+    mesh: &TriMesh,
+    plan: &LatticePlan,
+    first_tri: usize,
+    layout: &GroupLayout,
+    out: &mut DenseMesh,
+) {
+    let n = plan.n;
+    let vertex_count = layout.vertex_count();
+    let tris = layout.owns.len();
+    let per_tri_indices = 3 * (n * n) as usize;
+    // Every slot is overwritten below; filling in parallel spreads the first touch of the
+    // pages (the indices are zeroed by the kernel as they are first written).
+    out.sources = Vec::with_capacity(vertex_count);
+    out.sources.par_extend(rayon::iter::repeat_n(
+        VertexSource::lattice(0, 1, 0, 0),
+        vertex_count,
+    ));
+    out.indices = vec![0; tris * per_tri_indices];
+    let blocks = blocks::split(
+        out,
+        block_ranges(n, tris),
+        |t| layout.base[t] as usize,
+        |t| t * per_tri_indices,
+    );
+    blocks.into_par_iter().for_each(|mut block| {
+        let mut local = vec![0u32; plan.len];
+        for offset in block.tris.clone() {
+            number_triangle(
+                mesh, plan, layout, first_tri, offset, &mut block, &mut local,
+            );
+        }
+    });
+}
+
+/// Writes the sources of the vertices triangle `offset` of the group owns and its triangles,
+/// numbering its lattice as [`tessellate_block`] does through [`emit::TriangleWriter`].
+fn number_triangle(
+    mesh: &TriMesh,
+    plan: &LatticePlan,
+    layout: &GroupLayout,
+    first_tri: usize,
+    offset: usize,
+    block: &mut Block<'_>,
+    local: &mut [u32],
+) {
+    let n = plan.n;
+    let tri = first_tri + offset;
+    let corners = mesh.triangles[tri];
+    let owns = layout.owns[offset];
+    let base = block.vertex_base;
+    let sources = block
+        .sources
+        .as_deref_mut()
+        .expect("numbered blocks hold sources");
+    let source = |li: usize| {
+        let [i, j] = plan.lattice_ij[li];
+        VertexSource {
+            tri: tri as u32,
+            level: n as u8,
+            i,
+            j,
+        }
+    };
+    for (c, &li) in plan.corners.iter().enumerate() {
+        let slot = layout.corner_slot[3 * offset + c] as usize;
+        local[li as usize] = slot as u32;
+        if owns & (1 << c) != 0 {
+            sources[slot - base] = source(li as usize);
+        }
+    }
+    for (k, lis) in plan.edges.iter().enumerate() {
+        let first_slot = layout.edge_slot[3 * offset + k] as usize;
+        let ascending = corners[(k + 1) % 3] <= corners[(k + 2) % 3];
+        let owned = owns & (8 << k) != 0;
+        for m in 1..n {
+            // Sample m from corner k + 1, its slots run from the lower input vertex.
+            let slot = first_slot + (if ascending { m } else { n - m } - 1) as usize;
+            let li = lis[(m - 1) as usize] as usize;
+            local[li] = slot as u32;
+            if owned {
+                sources[slot - base] = source(li);
+            }
+        }
+    }
+    if plan.interior > 0 {
+        let first_slot = layout.base[offset + 1] as usize - plan.interior;
+        for (rank, &(li, _)) in plan.interior_by_rank.iter().enumerate() {
+            local[li as usize] = (first_slot + rank) as u32;
+            sources[first_slot + rank - base] = source(li as usize);
+        }
+    }
+    let per_tri_indices = 3 * (n * n) as usize;
+    let start = (offset - block.tris.start) * per_tri_indices;
+    emit::triangles(
+        &mut block.indices[start..start + per_tri_indices],
+        &plan.triangles,
+        local,
+    );
+}
+
+/// Evaluates and writes the vertices a block owns (their triangles and sources come after, in
+/// [`number_group`]). Each output vertex is evaluated once: corners are the input vertices,
+/// edge samples come from the shared pass (their normals too, unless this triangle is not the
+/// edge's evaluator), and only the interior is evaluated here.
 fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
     let Shared {
         mesh,
@@ -305,7 +478,6 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
         first_tri,
     } = *shared;
     let n = plan.n;
-    let per_tri_indices = 3 * (n * n) as usize;
     let mut writer = emit::TriangleWriter::new(mesh, topo, surface);
     let mut local = vec![0u32; plan.len];
     let mut parts = Vec::with_capacity(4);
@@ -377,11 +549,5 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
                 source,
             );
         }
-        let start = (offset - block.tris.start) * per_tri_indices;
-        emit::triangles(
-            &mut block.indices[start..start + per_tri_indices],
-            &plan.triangles,
-            &local,
-        );
     }
 }

@@ -214,3 +214,34 @@ fn corner_tests_on_lattice_coordinates_agree_with_the_barycentrics() {
         }
     }
 }
+
+/// The vertices are evaluated first and the triangles and vertex sources written from the
+/// numbering alone, so the surface can be freed in between (the pipeline does, to keep the
+/// surface and the output's index buffer out of memory at the same time): the result is the
+/// same mesh as with the surface alive throughout, seams, creases and groups included.
+#[test]
+fn the_surface_can_be_freed_before_the_triangles_are_written() {
+    use g2tess::tessellate::tessellate_vertices;
+    for mesh in [icosahedron(), split_normals(&bumpy_sphere(), 0.3)] {
+        let topo = Topology::build(&mesh);
+        // Every third welded edge a crease: its two sides get their own samples.
+        let requested: Vec<f64> = (0..topo.edge_count())
+            .map(|e| if e % 3 == 0 { 0.0 } else { 0.2 })
+            .collect();
+        let hs = widths(&topo, &requested);
+        let third = mesh.triangles.len() / 3;
+        let groups = [0..third, third..mesh.triangles.len()];
+        for level in 1..=5 {
+            let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+            let whole = tessellate(&mesh, &topo, &hs, &surface, level, &groups);
+            let vertices = tessellate_vertices(&mesh, &topo, &hs, &surface, level, &groups);
+            drop(surface);
+            let finished = vertices.finish();
+            assert!(finished == whole, "level {level}");
+            assert_eq!(finished.len(), 2);
+            for dense in &finished {
+                assert_eq!(dense.sources.len(), dense.positions.len(), "level {level}");
+            }
+        }
+    }
+}
