@@ -358,3 +358,81 @@ fn a_budget_leaves_a_flat_mesh_at_one_segment_per_edge() {
     let written = counts.triangle_count(&topo);
     assert!(written > 10_000 && written <= 20_000, "{written}");
 }
+
+/// A surface that passes every evaluation on to another and records which whole lattices
+/// `(triangle, level)` it was asked for, in order.
+struct LatticeLog<'a> {
+    surface: &'a dyn g2tess::surface::Surface,
+    lattices: std::sync::Mutex<Vec<(usize, u32)>>,
+}
+
+impl g2tess::surface::Surface for LatticeLog<'_> {
+    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> g2tess::surface::SurfacePoint {
+        self.surface.evaluate(tri, bary)
+    }
+
+    fn evaluate_lattice(
+        &self,
+        tri: usize,
+        level: u32,
+        out: &mut Vec<g2tess::surface::SurfacePoint>,
+    ) {
+        self.lattices.lock().unwrap().push((tri, level));
+        self.surface.evaluate_lattice(tri, level, out);
+    }
+
+    fn evaluate_lattice_part(
+        &self,
+        tri: usize,
+        level: u32,
+        part: g2tess::surface::LatticePart,
+        out: &mut Vec<g2tess::surface::SurfacePoint>,
+    ) {
+        self.surface.evaluate_lattice_part(tri, level, part, out);
+    }
+
+    fn evaluate_points(
+        &self,
+        tri: usize,
+        barys: &[[f64; 3]],
+        out: &mut Vec<g2tess::surface::SurfacePoint>,
+    ) {
+        self.surface.evaluate_points(tri, barys, out);
+    }
+}
+
+#[test]
+fn a_triangle_checked_again_with_only_its_edges_raised_reuses_its_lattice() {
+    // Near level 16 on an icosphere most triangles fail first along a transition ring, get
+    // that edge raised and are checked again at the same inner level: the lattice check reads
+    // the second differences it kept instead of evaluating the same lattice again. Lattices
+    // above the probe's level (which stage 1 can repeat at level 6) are the checks' own.
+    let mesh = icosphere(3);
+    let topo = Topology::build(&mesh);
+    let hs = h_all(&topo, 0.2);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let log = LatticeLog {
+        surface: &surface,
+        lattices: Default::default(),
+    };
+    let errors = ChordErrors::probe(&mesh, &topo, &surface);
+    let tolerance = 2e-5;
+    let logged = errors.refine_to_tolerance(&topo, &log, tolerance, 64);
+    assert_eq!(
+        logged,
+        errors.refine_to_tolerance(&topo, &surface, tolerance, 64),
+        "the log changes nothing"
+    );
+    assert!(logged.max() > 8, "counts {}", logged.max());
+    let lattices = log.lattices.into_inner().unwrap();
+    let mut last = vec![0u32; mesh.triangles.len()];
+    let mut repeats = 0;
+    for &(tri, level) in &lattices {
+        if level > g2tess::tessellate::PROBE_LEVEL && last[tri] == level {
+            repeats += 1;
+        }
+        last[tri] = level;
+    }
+    println!("{} lattices, {repeats} repeated", lattices.len());
+    assert_eq!(repeats, 0, "lattices evaluated twice in a row");
+}
