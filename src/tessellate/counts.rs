@@ -18,6 +18,8 @@
 //!
 //! It deliberately writes no vertex.
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
 use super::chord::{corner_error, measured_error};
@@ -192,11 +194,20 @@ impl ChordErrors {
                 predicted,
                 cap,
                 |key| PatternModel::new(&Pattern::new(key), check_level(key.inner, factor)),
-                |tri, model, (points, curvature): &mut (Vec<SurfacePoint>, Curvature)| {
+                |tri,
+                 model,
+                 (points, curvature): &mut (Vec<SurfacePoint>, Curvature),
+                 kept: &[[f64; 3]],
+                 keep: &mut Vec<[f64; 3]>| {
                     let level = check_level(model.inner(), factor);
-                    points.clear();
-                    surface.evaluate_lattice(tri, level, points);
-                    curvature.read(points, level);
+                    // The lattice depends on the triangle and the level alone: a triangle checked
+                    // again with only its edge counts raised reads the second differences it kept.
+                    if !curvature.restore(level, kept) {
+                        points.clear();
+                        surface.evaluate_lattice(tri, level, points);
+                        curvature.read(points, level);
+                    }
+                    keep.extend_from_slice(curvature.values());
                     model.error(curvature)
                 },
             );
@@ -206,7 +217,7 @@ impl ChordErrors {
             tolerance,
             cap,
             Pattern::new,
-            |tri, pattern, samples| {
+            |tri, pattern, samples, _: &[()], _: &mut Vec<()>| {
                 if pattern.key.inner > MEASURED_UP_TO {
                     return corner_error(surface, tri, pattern, samples);
                 }
@@ -327,15 +338,25 @@ impl SegmentCounts {
     /// Checks every triangle's pattern with `check` (on what `build` makes of its key, built
     /// once per distinct key) and raises the counts of its failing parts until none fails or
     /// they are at `cap`; after the first round only triangles whose counts changed are checked.
-    fn raise_until_met<P: Send + Sync, S: Default + Send>(
+    ///
+    /// `check` gets a per-thread scratch `S`, what the triangle's previous check kept (empty if
+    /// none), and a buffer to append what its next check could reuse. A failing triangle is
+    /// checked again next round, most often with only its edge counts raised; what it kept is
+    /// held for that one round, in one buffer per parallel chunk rather than one allocation per
+    /// triangle, and a passing triangle keeps nothing.
+    fn raise_until_met<P: Send + Sync, S: Default + Send, K: Copy + Send + Sync>(
         &mut self,
         topo: &Topology,
         tolerance: f64,
         cap: u32,
         build: impl Fn(PatternKey) -> P + Sync,
-        check: impl Fn(usize, &P, &mut S) -> PatternError + Sync,
+        check: impl Fn(usize, &P, &mut S, &[K], &mut Vec<K>) -> PatternError + Sync,
     ) {
         let mut checked: Vec<Option<PatternKey>> = vec![None; self.inner.len()];
+        // What the failing triangles of the last round kept: per triangle (in order), its
+        // chunk and range there.
+        let mut kept_at: Vec<(usize, usize, Range<usize>)> = Vec::new();
+        let mut kept: Vec<Vec<K>> = Vec::new();
         loop {
             let keys: Vec<PatternKey> = (0..self.inner.len()).map(|t| self.key(topo, t)).collect();
             let mut distinct: Vec<PatternKey> = keys
@@ -347,18 +368,45 @@ impl SegmentCounts {
             distinct.sort_unstable();
             distinct.dedup();
             let built: Vec<P> = distinct.par_iter().map(|&k| build(k)).collect();
-            let over: Vec<(usize, PatternError)> = (0..keys.len())
+            let previous = |t: usize| -> &[K] {
+                match kept_at.binary_search_by_key(&t, |(tri, _, _)| *tri) {
+                    Ok(i) => &kept[kept_at[i].1][kept_at[i].2.clone()],
+                    Err(_) => &[],
+                }
+            };
+            type Chunk<K> = (Vec<(usize, PatternError, Range<usize>)>, Vec<K>);
+            let chunks: Vec<Chunk<K>> = (0..keys.len())
                 .into_par_iter()
                 .filter(|&t| checked[t].as_ref() != Some(&keys[t]))
-                .map_init(S::default, |scratch, t| {
-                    let p = &built[distinct.binary_search(&keys[t]).ok()?];
-                    let error = check(t, p, scratch);
-                    let fails =
-                        error.inner > tolerance || error.edges.iter().any(|&e| e > tolerance);
-                    fails.then_some((t, error))
-                })
-                .flatten()
+                .fold(
+                    || (S::default(), Vec::new(), Vec::new()),
+                    |(mut scratch, mut over, mut keep), t| {
+                        if let Ok(p) = distinct.binary_search(&keys[t]) {
+                            let start = keep.len();
+                            let error = check(t, &built[p], &mut scratch, previous(t), &mut keep);
+                            let fails = error.inner > tolerance
+                                || error.edges.iter().any(|&e| e > tolerance);
+                            if fails {
+                                over.push((t, error, start..keep.len()));
+                            } else {
+                                keep.truncate(start);
+                            }
+                        }
+                        (scratch, over, keep)
+                    },
+                )
+                .map(|(_, over, keep)| (over, keep))
                 .collect();
+            let mut over: Vec<(usize, PatternError)> = Vec::new();
+            kept_at.clear();
+            kept.clear();
+            for (chunk, (failing, keep)) in chunks.into_iter().enumerate() {
+                for (t, error, range) in failing {
+                    over.push((t, error));
+                    kept_at.push((t, chunk, range));
+                }
+                kept.push(keep);
+            }
             for (c, k) in checked.iter_mut().zip(keys) {
                 *c = Some(k);
             }

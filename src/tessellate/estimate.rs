@@ -55,6 +55,27 @@ fn interior_index(n: u32, i: u32, j: u32) -> usize {
 }
 
 impl Curvature {
+    /// The second differences read, in interior lattice order: what [`Curvature::restore`]
+    /// takes back.
+    pub fn values(&self) -> &[[f64; 3]] {
+        &self.at
+    }
+
+    /// Takes back the [`Curvature::values`] of a level-`level` lattice read before, when
+    /// `values` has that lattice's number of interior points (which differs from level to level);
+    /// whether it did. A lattice of the same triangle and level has the same values, bit for
+    /// bit, so restoring them stands for reading it again.
+    pub fn restore(&mut self, level: u32, values: &[[f64; 3]]) -> bool {
+        let interior = (level.saturating_sub(1) * level.saturating_sub(2) / 2) as usize;
+        if level < 3 || values.len() != interior {
+            return false;
+        }
+        self.level = level;
+        self.at.clear();
+        self.at.extend_from_slice(values);
+        true
+    }
+
     /// Reads the second differences of `points`, the whole level-`level` lattice (`level ≥ 3`)
     /// in lattice order; reuses its own storage.
     pub fn read(&mut self, points: &[SurfacePoint], level: u32) {
