@@ -204,7 +204,7 @@ pub fn smooth_mesh(
     report.warnings.0.extend(
         surface_warnings
             .iter()
-            .filter_map(|w| Warning::from_surface(input.mesh, None, w)),
+            .map(|w| Warning::from_surface(input.mesh, None, w)),
     );
     report.edges = if options.report_figures {
         EdgeFigures::measure(surface.as_ref(), &topo, &effective)
@@ -298,7 +298,7 @@ pub fn smooth_mesh(
             // Every level's targets are made by the same surfaces: their warnings once.
             let target_warnings = target_warnings
                 .iter()
-                .filter_map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
+                .map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
                 .collect();
             merge_target_warnings(&mut report.warnings.0, target_warnings);
         }
