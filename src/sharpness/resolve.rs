@@ -450,3 +450,82 @@ fn check_context(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::DVec3;
+
+    use super::*;
+    use crate::sharpness::PrimitiveContext;
+
+    fn located(value: f64) -> Located<f64> {
+        Located {
+            value,
+            at: Arc::new(Location::Options),
+        }
+    }
+
+    fn context<'a>(primitives: &'a [PrimitiveContext<'a>]) -> MeshContext<'a> {
+        MeshContext {
+            index: 0,
+            name: None,
+            extras: None,
+            primitives,
+        }
+    }
+
+    fn primitive(vertex_offset: u32, vertex_count: u32) -> PrimitiveContext<'static> {
+        PrimitiveContext {
+            index: 0,
+            extras: None,
+            vertex_offset,
+            vertex_count,
+        }
+    }
+
+    fn mesh(vertices: usize) -> TriMesh {
+        TriMesh {
+            positions: vec![DVec3::ZERO; vertices],
+            normals: vec![DVec3::Z; vertices],
+            triangles: Vec::new(),
+        }
+    }
+
+    /// Sides are taken as one only where every triangle lies in a primitive and every
+    /// primitive reads its crease angle and extras h from the same place: a gap in the vertex
+    /// ranges (triangles outside every primitive), or two blocks that merely hold equal
+    /// values, keep the per-edge lookup.
+    #[test]
+    fn sides_are_uniform_only_where_every_side_reads_the_same_blocks() {
+        let (a, b) = (located(30.0), located(30.0));
+        let (h, other_h) = (located(0.1), located(0.1));
+        let two = [primitive(0, 4), primitive(4, 6)];
+        let m = mesh(10);
+
+        let same = uniform_sides(&context(&two), &m, &[Some(&a), Some(&a)], &[None, None]);
+        assert!(same.is_some_and(|(c, x)| c.is_some_and(|c| std::ptr::eq(c, &a)) && x.is_none()));
+        let none = uniform_sides(&context(&two), &m, &[None, None], &[None, None]);
+        assert_eq!(
+            none.map(|(c, x)| (c.is_none(), x.is_none())),
+            Some((true, true))
+        );
+
+        // Equal values from two places: where each came from differs.
+        assert!(uniform_sides(&context(&two), &m, &[Some(&a), Some(&b)], &[None, None]).is_none());
+        assert!(uniform_sides(&context(&two), &m, &[Some(&a), None], &[None, None]).is_none());
+        let hs = [Some((&h, true)), Some((&other_h, true))];
+        assert!(uniform_sides(&context(&two), &m, &[None, None], &hs).is_none());
+        let mesh_or_prim = [Some((&h, true)), Some((&h, false))];
+        assert!(uniform_sides(&context(&two), &m, &[None, None], &mesh_or_prim).is_none());
+
+        // Vertices outside every primitive: a gap, or past the last.
+        let gap = [primitive(0, 4), primitive(5, 5)];
+        assert!(uniform_sides(&context(&gap), &m, &[None, None], &[None, None]).is_none());
+        assert!(uniform_sides(&context(&two), &mesh(11), &[None, None], &[None, None]).is_none());
+        // In any order.
+        let swapped = [primitive(4, 6), primitive(0, 4)];
+        assert!(uniform_sides(&context(&swapped), &m, &[None, None], &[None, None]).is_some());
+    }
+}
