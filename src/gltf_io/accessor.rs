@@ -13,6 +13,7 @@ use std::borrow::Cow;
 
 use gltf_json::accessor::{ComponentType, Type};
 use gltf_json::validation::Checked;
+use rayon::prelude::*;
 
 use super::document::Document;
 use super::error::{Error, Result};
@@ -31,6 +32,9 @@ pub struct Accessor<'a> {
     pub count: usize,
     bytes: Cow<'a, [u8]>,
 }
+
+/// Components per task of a parallel scan ([`Accessor::find_first`]).
+pub(crate) const SCAN_BLOCK: usize = 1 << 14;
 
 /// Bytes per component.
 pub fn component_size(t: ComponentType) -> usize {
@@ -293,6 +297,39 @@ impl Accessor<'_> {
         }
     }
 
+    /// [`Accessor::find`] for a test that needs no state, run in parallel over the components:
+    /// the same first hit whatever the thread count. The reader's data checks (non-finite
+    /// floats, indices out of range) are each one such scan over every array of the file, which
+    /// for a large mesh cost as much as decoding it.
+    pub fn find_first(&self, hit: impl Fn(f64) -> bool + Sync) -> Option<(usize, f64)> {
+        fn scan<const N: usize>(
+            bytes: &[u8],
+            widen: impl Fn([u8; N]) -> f64 + Sync,
+            hit: &(impl Fn(f64) -> bool + Sync),
+        ) -> Option<(usize, f64)> {
+            let at = |b: &[u8]| widen(b.try_into().expect("chunks of N bytes"));
+            // Blocks of components scanned one after another: a parallel search per component
+            // costs more than the test.
+            let k = bytes
+                .par_chunks(SCAN_BLOCK * N)
+                .enumerate()
+                .find_map_first(|(i, block)| {
+                    let k = block.chunks_exact(N).position(|b| hit(at(b)))?;
+                    Some(i * SCAN_BLOCK + k)
+                })?;
+            Some((k, at(&bytes[k * N..(k + 1) * N])))
+        }
+        let b = &self.bytes[..];
+        match self.component_type {
+            ComponentType::I8 => scan(b, |x: [u8; 1]| f64::from(x[0] as i8), &hit),
+            ComponentType::U8 => scan(b, |x: [u8; 1]| f64::from(x[0]), &hit),
+            ComponentType::I16 => scan(b, |x| f64::from(i16::from_le_bytes(x)), &hit),
+            ComponentType::U16 => scan(b, |x| f64::from(u16::from_le_bytes(x)), &hit),
+            ComponentType::U32 => scan(b, |x| f64::from(u32::from_le_bytes(x)), &hit),
+            ComponentType::F32 => scan(b, |x| f64::from(f32::from_le_bytes(x)), &hit),
+        }
+    }
+
     /// Calls `visit` with every component in order (widened as [`Accessor::find`] does).
     pub fn for_each(&self, mut visit: impl FnMut(f64)) {
         self.find(|x| {
@@ -305,6 +342,8 @@ impl Accessor<'_> {
     /// (e.g. `max(c / 127, -1)` for signed bytes); floats are bit-exact.
     pub fn to_f32(&self) -> Vec<f32> {
         if self.component_type == ComponentType::F32 {
+            // One thread: this loop compiles to vector moves, which a parallel collect (one
+            // element at a time) costs twenty times the instructions of.
             return self
                 .bytes
                 .chunks_exact(4)

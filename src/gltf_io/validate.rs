@@ -417,7 +417,7 @@ fn carried_accessors(root: &gltf_json::Root) -> Vec<bool> {
 }
 
 /// Data checks: finite floats, bounds arrays of the right length (and equal to the data where
-/// the accessor is carried through), indices in range, unit normals, valid skin weights.
+/// the accessor is carried through), indices in range, unit tangents, valid skin weights.
 ///
 /// Every accessor is decoded, so their declared sizes together must fit in `budget` (see
 /// [`super::ReadOptions::EXPANSION_FACTOR`]); each is checked before it is allocated.
@@ -438,7 +438,7 @@ pub fn data(doc: &Document, max_bytes: u64, budget: u64) -> Result<()> {
         // Read in place where the data is tightly packed: checking copies nothing.
         let acc = accessor::read(doc, i, max_bytes)?;
         if acc.component_type == ComponentType::F32 {
-            if let Some((k, x)) = acc.find(|x| !x.is_finite()) {
+            if let Some((k, x)) = acc.find_first(|x| !x.is_finite()) {
                 return Err(Error::invalid(
                     &at,
                     format!(
@@ -475,20 +475,22 @@ pub fn data(doc: &Document, max_bytes: u64, budget: u64) -> Result<()> {
                     ComponentType::U16 => 65535.0,
                     _ => 4294967295.0,
                 };
-                if let Some((k, v)) = acc.find(|v| v == restart || v >= vertices as f64) {
+                if let Some((k, v)) = acc.find_first(|v| v == restart || v >= vertices as f64) {
                     return Err(Error::invalid(
                         format!("{at}.indices"),
                         format!("index {v} at position {k} (expected a vertex below {vertices}, not the restart value {restart})"),
                     ));
                 }
             }
+            // Normals need no check of their own: a normal's direction is all the surface
+            // needs (the pipeline normalizes one of another length and rebuilds a zero one, an
+            // exporter's "no normal here", from the faces around its vertex, each with a
+            // warning), and finiteness, all that matters, was checked for every float accessor
+            // above (integer ones are finite).
             for (sem, ix) in &prim.attributes {
-                let acc = get(ix.value());
-                let aat = format!("{at}.attributes.{}", semantic_name(sem));
-                match sem {
-                    Checked::Valid(Semantic::Normals) => unit_vectors(acc, &aat, false)?,
-                    Checked::Valid(Semantic::Tangents) => unit_vectors(acc, &aat, true)?,
-                    _ => {}
+                if *sem == Checked::Valid(Semantic::Tangents) {
+                    let aat = format!("{at}.attributes.{}", semantic_name(sem));
+                    unit_tangents(get(ix.value()), &aat)?;
                 }
             }
             skin_data(doc, m, prim, &at, &get)?;
@@ -497,16 +499,13 @@ pub fn data(doc: &Document, max_bytes: u64, budget: u64) -> Result<()> {
     Ok(())
 }
 
+/// Declared `min` and `max` must be arrays of one number per component, and equal the data's
+/// own bounds where the accessor is carried through unchanged. The data's bounds are computed
+/// only there: a triangle primitive's accessors are rewritten with fresh bounds, and scanning
+/// them (most of a large file) would decide nothing.
 fn check_bounds(a: &gltf_json::Accessor, acc: &Accessor, carried: bool, at: &str) -> Result<()> {
-    let mut actual_min = vec![f64::INFINITY; acc.components];
-    let mut actual_max = vec![f64::NEG_INFINITY; acc.components];
-    let mut c = 0;
-    acc.for_each(|x| {
-        actual_min[c] = actual_min[c].min(x);
-        actual_max[c] = actual_max[c].max(x);
-        c = if c + 1 == acc.components { 0 } else { c + 1 };
-    });
-    for (key, declared, actual) in [("min", &a.min, &actual_min), ("max", &a.max, &actual_max)] {
+    let mut bounds = None;
+    for (key, declared) in [("min", &a.min), ("max", &a.max)] {
         let Some(declared) = declared else { continue };
         let values: Option<Vec<f64>> = declared
             .as_array()
@@ -526,6 +525,8 @@ fn check_bounds(a: &gltf_json::Accessor, acc: &Accessor, carried: bool, at: &str
         if !carried || acc.is_empty() || zero_filled {
             continue;
         }
+        let (actual_min, actual_max) = bounds.get_or_insert_with(|| data_bounds(acc));
+        let actual = if key == "min" { actual_min } else { actual_max };
         let float = acc.component_type == ComponentType::F32;
         for (c, (d, v)) in values.iter().zip(actual.iter()).enumerate() {
             let same = if float {
@@ -544,21 +545,23 @@ fn check_bounds(a: &gltf_json::Accessor, acc: &Accessor, carried: bool, at: &str
     Ok(())
 }
 
-fn unit_vectors(acc: &Accessor<'_>, at: &str, tangent: bool) -> Result<()> {
+/// The per-component minimum and maximum of `acc`'s data, widened as [`Accessor::for_each`]
+/// gives it.
+fn data_bounds(acc: &Accessor) -> (Vec<f64>, Vec<f64>) {
+    let mut actual_min = vec![f64::INFINITY; acc.components];
+    let mut actual_max = vec![f64::NEG_INFINITY; acc.components];
+    let mut c = 0;
+    acc.for_each(|x| {
+        actual_min[c] = actual_min[c].min(x);
+        actual_max[c] = actual_max[c].max(x);
+        c = if c + 1 == acc.components { 0 } else { c + 1 };
+    });
+    (actual_min, actual_max)
+}
+
+/// Tangents are finite unit vectors with w = ±1.
+fn unit_tangents(acc: &Accessor<'_>, at: &str) -> Result<()> {
     let n = acc.components;
-    if !tangent {
-        // Only finiteness matters for a normal (see below): checked in place, uncopied.
-        return match acc.find(|x| !x.is_finite()) {
-            Some((k, _)) => Err(Error::invalid(
-                at,
-                format!(
-                    "element {} is not finite (expected a unit vector)",
-                    k / n.max(1)
-                ),
-            )),
-            None => Ok(()),
-        };
-    }
     let v = acc.to_f32();
     for (e, chunk) in v.chunks_exact(n).enumerate() {
         if chunk.iter().any(|x| !x.is_finite()) {
@@ -567,12 +570,6 @@ fn unit_vectors(acc: &Accessor<'_>, at: &str, tangent: bool) -> Result<()> {
                 format!("element {e} is not finite (expected a unit vector)"),
             ));
         }
-        // A normal's direction is all the surface needs: the pipeline normalizes one of another
-        // length and rebuilds a zero one (an exporter's "no normal here") from the faces
-        // around its vertex, each with a warning. Only a tangent's length is checked here.
-        if !tangent {
-            continue;
-        }
         let len = (chunk[..3].iter().map(|x| (*x as f64).powi(2)).sum::<f64>()).sqrt();
         if (len - 1.0).abs() > UNIT_TOLERANCE {
             return Err(Error::invalid(
@@ -580,7 +577,7 @@ fn unit_vectors(acc: &Accessor<'_>, at: &str, tangent: bool) -> Result<()> {
                 format!("element {e} has length {len:.4} (expected a unit vector)"),
             ));
         }
-        if tangent && n == 4 && chunk[3].abs() != 1.0 {
+        if n == 4 && chunk[3].abs() != 1.0 {
             return Err(Error::invalid(
                 at,
                 format!("element {e} has w = {} (expected 1 or -1)", chunk[3]),

@@ -204,7 +204,7 @@ pub fn smooth_mesh(
     report.warnings.0.extend(
         surface_warnings
             .iter()
-            .filter_map(|w| Warning::from_surface(input.mesh, None, w)),
+            .map(|w| Warning::from_surface(input.mesh, None, w)),
     );
     report.edges = if options.report_figures {
         EdgeFigures::measure(surface.as_ref(), &topo, &effective)
@@ -310,7 +310,7 @@ pub fn smooth_mesh(
             // Every level's targets are made by the same surfaces: their warnings once.
             let target_warnings = target_warnings
                 .iter()
-                .filter_map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
+                .map(|(t, w)| Warning::from_surface(input.mesh, Some(*t), w))
                 .collect();
             merge_target_warnings(&mut report.warnings.0, target_warnings);
         }
@@ -451,7 +451,12 @@ fn prepare(
     let at = format!("meshes[{mesh}].primitives[{}]", input.index);
     let positions = data.positions(&at)?;
     let vertex_count = positions.len() / 3;
-    if let Some(bad) = data.indices.iter().find(|&&i| i as usize >= vertex_count) {
+    // In blocks: a parallel search per index costs more than the comparison.
+    let out_of_range = data
+        .indices
+        .par_chunks(1 << 14)
+        .find_map_first(|block| block.iter().find(|&&i| i as usize >= vertex_count));
+    if let Some(bad) = out_of_range {
         return Err(gltf_io::Error::invalid(
             format!("{at}.indices"),
             format!("index {bad} is out of range (expected below the vertex count {vertex_count})"),
@@ -474,8 +479,12 @@ fn prepare(
                 .into_par_iter()
                 .map(|v| raw(v).normalize_or_zero())
                 .collect();
-            let rescaled = |v: usize| normals[v] != DVec3::ZERO && !unit_to_validator(raw(v));
-            let (count, first) = first_and_count(normals.len(), rescaled);
+            // One pass finds both the rescaled normals and the broken ones.
+            let NormalFlaws {
+                rescaled: count,
+                first_rescaled: first,
+                broken,
+            } = NormalFlaws::of(&normals, raw);
             if let Some(first) = first {
                 warnings.push(Warning::NormalsRescaled {
                     mesh,
@@ -486,10 +495,6 @@ fn prepare(
                     length: raw(first).length() as f32,
                 });
             }
-            let broken: Vec<usize> = (0..normals.len())
-                .into_par_iter()
-                .filter(|&v| normals[v] == DVec3::ZERO || !normals[v].is_finite())
-                .collect();
             if let Some(&first) = broken.first() {
                 repair_normals(&points, &triangles, &broken, &mut normals);
                 warnings.push(Warning::NormalsRepaired {
@@ -531,16 +536,41 @@ fn without_core_values(mut prepared: Prepared) -> Prepared {
     prepared
 }
 
-/// How many of `0..n` pass `hit`, and the first that does, tested in parallel.
-fn first_and_count(n: usize, hit: impl Fn(usize) -> bool + Sync) -> (usize, Option<usize>) {
-    (0..n)
-        .into_par_iter()
-        .filter(|&v| hit(v))
-        .fold(
-            || (0, None),
-            |(c, f): (usize, Option<usize>), v| (c + 1, f.or(Some(v))),
-        )
-        .reduce(|| (0, None), |a, b| (a.0 + b.0, a.1.or(b.1)))
+/// What is wrong with a primitive's input normals, found in one parallel pass.
+#[derive(Debug, Default)]
+struct NormalFlaws {
+    /// How many were not unit length to the validator (but not zero): they were rescaled.
+    rescaled: usize,
+    /// The first of those.
+    first_rescaled: Option<usize>,
+    /// Every vertex whose normal is zero or not finite (to repair), in order.
+    broken: Vec<usize>,
+}
+
+impl NormalFlaws {
+    /// `normals[v]` is `raw(v)` normalized (zero where it cannot be). The parts are folded in
+    /// vertex order and joined left to right, so the result does not depend on the threads.
+    fn of(normals: &[DVec3], raw: impl Fn(usize) -> DVec3 + Sync) -> NormalFlaws {
+        (0..normals.len())
+            .into_par_iter()
+            .fold(NormalFlaws::default, |mut f, v| {
+                let n = normals[v];
+                if n != DVec3::ZERO && !unit_to_validator(raw(v)) {
+                    f.rescaled += 1;
+                    f.first_rescaled = f.first_rescaled.or(Some(v));
+                }
+                if n == DVec3::ZERO || !n.is_finite() {
+                    f.broken.push(v);
+                }
+                f
+            })
+            .reduce(NormalFlaws::default, |mut a, mut b| {
+                a.rescaled += b.rescaled;
+                a.first_rescaled = a.first_rescaled.or(b.first_rescaled);
+                a.broken.append(&mut b.broken);
+                a
+            })
+    }
 }
 
 /// Whether `n` is unit length within the Khronos validator's tolerance for unit vectors.

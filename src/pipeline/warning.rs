@@ -20,7 +20,7 @@ use serde::{Serialize, Serializer};
 
 use crate::sharpness::{Location, SharpnessWarning};
 use crate::surface::scheme;
-use crate::topology::{self, EdgeId, EdgeKind};
+use crate::topology::{EdgeId, EdgeKind};
 
 /// One warning of one mesh, with the facts that locate it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -182,41 +182,16 @@ impl Warning {
 
     /// A surface's warning about mesh `mesh`, from the base surface (`target` `None`) or the
     /// surface of one morph target.
-    ///
-    /// `None` for a surface's "blend ignored" ([`topology::Warning::BlendIgnored`]): the
-    /// pipeline builds every surface, the morph targets' too, from the effective widths
-    /// ([`crate::sharpness::EffectiveH`]), already 0 on every edge the surface cannot blend, so
-    /// a surface never says it here; the one input that asks for it, an h entry naming such an
-    /// edge, is reported where it is resolved ([`Warning::UnblendedEdgeEntry`]).
-    pub fn from_surface(
-        mesh: usize,
-        target: Option<usize>,
-        w: &scheme::Warning,
-    ) -> Option<Warning> {
+    pub fn from_surface(mesh: usize, target: Option<usize>, w: &scheme::Warning) -> Warning {
         let targets: Vec<usize> = target.into_iter().collect();
-        Some(match w {
-            scheme::Warning::Edges(topology::Warning::BlendIgnored { .. }) => return None,
-            scheme::Warning::Edges(topology::Warning::DegenerateTriangle { tri }) => {
-                Warning::DegenerateTriangles {
-                    mesh,
-                    count: 1,
-                    triangles: vec![tri.0 as usize],
-                }
-            }
-            scheme::Warning::Edges(topology::Warning::NonManifoldEdge { edge, .. }) => {
-                Warning::NonManifoldEdges {
-                    mesh,
-                    count: 1,
-                    edges: vec![edge.0 as usize],
-                }
-            }
+        match w {
             scheme::Warning::NoProjectionPlane { edges, first } => Warning::NoProjectionPlane {
                 mesh,
                 targets,
                 count: *edges,
                 edge: first.0 as usize,
             },
-        })
+        }
     }
 
     /// The morph targets whose surfaces gave it (empty for everything else).
@@ -599,17 +574,10 @@ mod tests {
         }];
         for w in &said {
             assert_eq!(
-                Warning::from_surface(5, None, w).unwrap().to_string(),
+                Warning::from_surface(5, None, w).to_string(),
                 format!("mesh 5: {w}")
             );
         }
-        // Never said by a surface the pipeline builds (see `from_surface`).
-        let ignored = scheme::Warning::Edges(topology::Warning::BlendIgnored {
-            kind: EdgeKind::Boundary,
-            edges: 1,
-            first: EdgeId(0),
-        });
-        assert_eq!(Warning::from_surface(5, None, &ignored), None);
         let entry = SharpnessWarning::EntryOnUnblendedEdge {
             at: Location::Toml {
                 file: "robot.g2tess.toml".into(),

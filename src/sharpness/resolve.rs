@@ -77,7 +77,6 @@ pub(crate) fn resolve(
                 .map(|h| (h, false)))
         })
         .collect();
-    let prim_of_tri = primitive_of_triangle(ctx, mesh);
     // The crease angle and extras default on the side of triangles outside every primitive.
     let outside_crease = section
         .and_then(|b| b.crease_angle.as_ref())
@@ -106,59 +105,75 @@ pub(crate) fn resolve(
         NO_PRIMITIVE => outside_test,
         p => test_of_prim[p as usize],
     };
+    // Where every side agrees (one primitive, or several with the same blocks, covering every
+    // vertex: the common case), an edge's sides need not be looked up at all, nor each
+    // triangle's primitive found.
+    let uniform = uniform_sides(ctx, mesh, &crease_of_prim, &extras_h_of_prim)
+        .map(|(crease, h)| (test_of(crease), crease, h));
+    let prim_of_tri = match uniform {
+        Some(_) => Vec::new(),
+        None => primitive_of_triangle(ctx, mesh),
+    };
 
     // Edges are independent: resolved in parallel, collected in edge order.
-    let source_of = |(e, edge): (usize, Edge<'_>)| {
-        let id = EdgeId(e as u32);
+    let pick = |(e, edge): &(usize, Edge<'_>)| {
+        let id = EdgeId(*e as u32);
         // The primitives on the edge's sides, read straight from its uses: the sharpest
         // value wins, ties going to the lowest primitive (triangles outside every
         // primitive first), whatever the order of the uses.
         let sides = || edge.tris.iter().map(|u| prim_of_tri[u.at().0]);
-        let (value, source) = if let Some(x) = sidecar_edges.get(&id) {
-            (x.value, HSource::SidecarEdge(x.at.clone()))
-        } else if let Some(x) = prim_edges.get(&id) {
-            (x.value, HSource::PrimitiveExtrasEdge(x.at.clone()))
-        } else if let Some(x) = mesh_edges.get(&id) {
-            (x.value, HSource::MeshExtrasEdge(x.at.clone()))
-        } else if let Some(rule) = crease_rule(
-            &edge,
-            topo,
-            sharpest(sides(), |p| {
+        let uniform = uniform.filter(|_| !edge.tris.is_empty());
+        if let Some(x) = entry_of(&sidecar_edges, id) {
+            return Pick::SidecarEdge(x);
+        }
+        if let Some(x) = entry_of(&prim_edges, id) {
+            return Pick::PrimitiveExtrasEdge(x);
+        }
+        if let Some(x) = entry_of(&mesh_edges, id) {
+            return Pick::MeshExtrasEdge(x);
+        }
+        let crease_side = match uniform {
+            Some((test, crease, _)) => (test, crease),
+            None => sharpest(sides(), |p| {
                 side_crease(p).map_or(asset.defaults.crease_angle, |a| a.value)
             })
             .map_or((default_test, None), |p| (side_test(p), side_crease(p))),
-        ) {
-            (0.0, rule)
-        } else if asset.defaults.keep_hard_edges && is_hard_edge(&edge) {
-            (0.0, HSource::HardEdge)
-        } else if let Some(x) = section.and_then(|b| b.h.as_ref()) {
-            (x.value, HSource::SidecarMeshDefault(x.at.clone()))
-        } else if let Some((x, on_prim)) = sharpest(sides().filter(|&p| side_h(p).is_some()), |p| {
-            side_h(p).map_or(f64::INFINITY, |x| x.0.value)
-        })
-        .and_then(side_h)
-        {
-            let at = x.at.clone();
-            let source = if on_prim {
-                HSource::PrimitiveExtrasDefault(at)
-            } else {
-                HSource::MeshExtrasDefault(at)
-            };
-            (x.value, source)
-        } else if let Some(x) = sidecar_asset.and_then(|b| b.h.as_ref()) {
-            (x.value, HSource::SidecarAssetDefault(x.at.clone()))
-        } else {
-            (asset.defaults.h, HSource::Options)
         };
-        (value, EffectiveH::of_edge(edge.kind, value), source)
+        if let Some(rule) = crease_rule(edge, topo, crease_side) {
+            return rule;
+        }
+        if asset.defaults.keep_hard_edges && is_hard_edge(edge) {
+            return Pick::HardEdge;
+        }
+        if let Some(x) = section.and_then(|b| b.h.as_ref()) {
+            return Pick::SidecarMeshDefault(x);
+        }
+        let side_default = match uniform {
+            Some((_, _, h)) => h,
+            None => sharpest(sides().filter(|&p| side_h(p).is_some()), |p| {
+                side_h(p).map_or(f64::INFINITY, |x| x.0.value)
+            })
+            .and_then(side_h),
+        };
+        match (side_default, sidecar_asset.and_then(|b| b.h.as_ref())) {
+            (Some((x, true)), _) => Pick::PrimitiveExtrasDefault(x),
+            (Some((x, false)), _) => Pick::MeshExtrasDefault(x),
+            (None, Some(x)) => Pick::SidecarAssetDefault(x),
+            (None, None) => Pick::Options(asset.defaults.h),
+        }
     };
-    // The sources (32 bytes per edge) are kept only for `--explain-h`.
+    // The sources (32 bytes per edge) are kept only for `--explain-h`; the others never clone
+    // a location.
     let (h, (effective, sources)): (Vec<f64>, (Vec<f64>, Vec<HSource>)) = if asset.keep_sources {
         topo.par_edges()
             .enumerate()
             .map(|e| {
-                let (value, effective, source) = source_of(e);
-                (value, (effective, source))
+                let picked = pick(&e);
+                let value = picked.value();
+                (
+                    value,
+                    (EffectiveH::of_edge(e.1.kind, value), picked.source()),
+                )
             })
             .unzip()
     } else {
@@ -166,8 +181,8 @@ pub(crate) fn resolve(
             .par_edges()
             .enumerate()
             .map(|e| {
-                let (value, effective, _) = source_of(e);
-                (value, effective)
+                let value = pick(&e).value();
+                (value, EffectiveH::of_edge(e.1.kind, value))
             })
             .unzip();
         (h, (effective, Vec::new()))
@@ -194,18 +209,128 @@ fn sharpest(sides: impl Iterator<Item = u32>, value: impl Fn(u32) -> f64) -> Opt
 /// The crease rule for one edge under the sharpest of its sides' crease angles (`side`: that
 /// side's rule, and where its angle was set, `None` for the options' angle): h = 0 if the faces
 /// meet at more than that angle.
-fn crease_rule(
+fn crease_rule<'a>(
     edge: &Edge<'_>,
     topo: &Topology,
-    side: (CreaseTest, Option<&Located<f64>>),
-) -> Option<HSource> {
+    side: (CreaseTest, Option<&'a Located<f64>>),
+) -> Option<Pick<'a>> {
     let (test, set_by) = side;
     let dihedral = test.dihedral_if_crease(edge, topo)?;
-    Some(HSource::Crease {
+    Some(Pick::Crease {
         dihedral,
         crease_angle: test.crease_angle(),
-        set_by: set_by.map(|a| a.at.clone()),
+        set_by,
     })
+}
+
+/// The entry of one precedence level for edge `id`; an empty level (the common case) is not
+/// hashed into.
+fn entry_of(level: &HashMap<EdgeId, Located<f64>>, id: EdgeId) -> Option<&Located<f64>> {
+    if level.is_empty() {
+        None
+    } else {
+        level.get(&id)
+    }
+}
+
+/// The source that decided an edge's h, as [`HSource`] names it, holding references: turned
+/// into an [`HSource`] (which shares each location) only where the sources are kept, so the
+/// run without `--explain-h` touches no reference count per edge.
+#[derive(Debug, Clone, Copy)]
+enum Pick<'a> {
+    SidecarEdge(&'a Located<f64>),
+    PrimitiveExtrasEdge(&'a Located<f64>),
+    MeshExtrasEdge(&'a Located<f64>),
+    Crease {
+        dihedral: f64,
+        crease_angle: f64,
+        set_by: Option<&'a Located<f64>>,
+    },
+    HardEdge,
+    SidecarMeshDefault(&'a Located<f64>),
+    PrimitiveExtrasDefault(&'a Located<f64>),
+    MeshExtrasDefault(&'a Located<f64>),
+    SidecarAssetDefault(&'a Located<f64>),
+    /// The options' h.
+    Options(f64),
+}
+
+impl Pick<'_> {
+    /// The h this source asks for.
+    fn value(self) -> f64 {
+        match self {
+            Pick::SidecarEdge(x)
+            | Pick::PrimitiveExtrasEdge(x)
+            | Pick::MeshExtrasEdge(x)
+            | Pick::SidecarMeshDefault(x)
+            | Pick::PrimitiveExtrasDefault(x)
+            | Pick::MeshExtrasDefault(x)
+            | Pick::SidecarAssetDefault(x) => x.value,
+            Pick::Crease { .. } | Pick::HardEdge => 0.0,
+            Pick::Options(h) => h,
+        }
+    }
+
+    fn source(self) -> HSource {
+        match self {
+            Pick::SidecarEdge(x) => HSource::SidecarEdge(x.at.clone()),
+            Pick::PrimitiveExtrasEdge(x) => HSource::PrimitiveExtrasEdge(x.at.clone()),
+            Pick::MeshExtrasEdge(x) => HSource::MeshExtrasEdge(x.at.clone()),
+            Pick::Crease {
+                dihedral,
+                crease_angle,
+                set_by,
+            } => HSource::Crease {
+                dihedral,
+                crease_angle,
+                set_by: set_by.map(|a| a.at.clone()),
+            },
+            Pick::HardEdge => HSource::HardEdge,
+            Pick::SidecarMeshDefault(x) => HSource::SidecarMeshDefault(x.at.clone()),
+            Pick::PrimitiveExtrasDefault(x) => HSource::PrimitiveExtrasDefault(x.at.clone()),
+            Pick::MeshExtrasDefault(x) => HSource::MeshExtrasDefault(x.at.clone()),
+            Pick::SidecarAssetDefault(x) => HSource::SidecarAssetDefault(x.at.clone()),
+            Pick::Options(_) => HSource::Options,
+        }
+    }
+}
+
+/// The crease angle and extras default h shared by every side of every edge, where there is
+/// one: the primitives cover every vertex of the mesh (so no triangle lies outside them) and
+/// all carry the same ones (the same block's, or none). `None` where sides may differ.
+#[allow(clippy::type_complexity)]
+fn uniform_sides<'a>(
+    ctx: &MeshContext<'_>,
+    mesh: &TriMesh,
+    crease_of_prim: &[Option<&'a Located<f64>>],
+    extras_h_of_prim: &[Option<(&'a Located<f64>, bool)>],
+) -> Option<(Option<&'a Located<f64>>, Option<(&'a Located<f64>, bool)>)> {
+    let mut ranges: Vec<(u32, u32)> = ctx
+        .primitives
+        .iter()
+        .map(|p| (p.vertex_offset, p.vertex_count))
+        .collect();
+    ranges.sort_unstable();
+    let mut end = 0u64;
+    for (offset, count) in ranges {
+        if u64::from(offset) != end {
+            return None;
+        }
+        end += u64::from(count);
+    }
+    if end != mesh.positions.len() as u64 {
+        return None;
+    }
+    let same_place = |a: Option<&Located<f64>>, b: Option<&Located<f64>>| match (a, b) {
+        (Some(a), Some(b)) => std::ptr::eq(a, b),
+        (a, b) => a.is_none() && b.is_none(),
+    };
+    let (&crease, &h) = (crease_of_prim.first()?, extras_h_of_prim.first()?);
+    let agree = crease_of_prim.iter().all(|&c| same_place(c, crease))
+        && extras_h_of_prim.iter().all(|&x| {
+            same_place(x.map(|x| x.0), h.map(|h| h.0)) && x.map(|x| x.1) == h.map(|h| h.1)
+        });
+    agree.then_some((crease, h))
 }
 
 /// Collects one precedence level of edge entries into a map, rejecting two different h for one
@@ -324,4 +449,83 @@ fn check_context(
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::DVec3;
+
+    use super::*;
+    use crate::sharpness::PrimitiveContext;
+
+    fn located(value: f64) -> Located<f64> {
+        Located {
+            value,
+            at: Arc::new(Location::Options),
+        }
+    }
+
+    fn context<'a>(primitives: &'a [PrimitiveContext<'a>]) -> MeshContext<'a> {
+        MeshContext {
+            index: 0,
+            name: None,
+            extras: None,
+            primitives,
+        }
+    }
+
+    fn primitive(vertex_offset: u32, vertex_count: u32) -> PrimitiveContext<'static> {
+        PrimitiveContext {
+            index: 0,
+            extras: None,
+            vertex_offset,
+            vertex_count,
+        }
+    }
+
+    fn mesh(vertices: usize) -> TriMesh {
+        TriMesh {
+            positions: vec![DVec3::ZERO; vertices],
+            normals: vec![DVec3::Z; vertices],
+            triangles: Vec::new(),
+        }
+    }
+
+    /// Sides are taken as one only where every triangle lies in a primitive and every
+    /// primitive reads its crease angle and extras h from the same place: a gap in the vertex
+    /// ranges (triangles outside every primitive), or two blocks that merely hold equal
+    /// values, keep the per-edge lookup.
+    #[test]
+    fn sides_are_uniform_only_where_every_side_reads_the_same_blocks() {
+        let (a, b) = (located(30.0), located(30.0));
+        let (h, other_h) = (located(0.1), located(0.1));
+        let two = [primitive(0, 4), primitive(4, 6)];
+        let m = mesh(10);
+
+        let same = uniform_sides(&context(&two), &m, &[Some(&a), Some(&a)], &[None, None]);
+        assert!(same.is_some_and(|(c, x)| c.is_some_and(|c| std::ptr::eq(c, &a)) && x.is_none()));
+        let none = uniform_sides(&context(&two), &m, &[None, None], &[None, None]);
+        assert_eq!(
+            none.map(|(c, x)| (c.is_none(), x.is_none())),
+            Some((true, true))
+        );
+
+        // Equal values from two places: where each came from differs.
+        assert!(uniform_sides(&context(&two), &m, &[Some(&a), Some(&b)], &[None, None]).is_none());
+        assert!(uniform_sides(&context(&two), &m, &[Some(&a), None], &[None, None]).is_none());
+        let hs = [Some((&h, true)), Some((&other_h, true))];
+        assert!(uniform_sides(&context(&two), &m, &[None, None], &hs).is_none());
+        let mesh_or_prim = [Some((&h, true)), Some((&h, false))];
+        assert!(uniform_sides(&context(&two), &m, &[None, None], &mesh_or_prim).is_none());
+
+        // Vertices outside every primitive: a gap, or past the last.
+        let gap = [primitive(0, 4), primitive(5, 5)];
+        assert!(uniform_sides(&context(&gap), &m, &[None, None], &[None, None]).is_none());
+        assert!(uniform_sides(&context(&two), &mesh(11), &[None, None], &[None, None]).is_none());
+        // In any order.
+        let swapped = [primitive(4, 6), primitive(0, 4)];
+        assert!(uniform_sides(&context(&swapped), &m, &[None, None], &[None, None]).is_some());
+    }
 }

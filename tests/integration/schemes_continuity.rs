@@ -9,7 +9,7 @@ use g2tess::surface::coons::{Constituents, CoonsSurface, NormalMethod};
 use g2tess::surface::hybrid::HybridSurface;
 use g2tess::surface::scheme::Warning;
 use g2tess::surface::{Nets, PnSurface, SchemeParams, Surface};
-use g2tess::topology::{self, EdgeKind, Topology};
+use g2tess::topology::Topology;
 
 /// Positions are sums of ten terms of size ~|p| ≤ 2L: a gap above 1e-13·L is not rounding.
 const GAP_TOL: f64 = 1e-13;
@@ -42,17 +42,10 @@ fn meshes() -> Vec<(String, TriMesh)> {
     out
 }
 
-/// Only the expected warning: boundary edges (the height field's) asked for h > 0.
+/// No edge fell back to a crease for want of a projection plane.
 fn no_plane_fallback(w: &[Warning]) -> bool {
-    w.iter().all(|w| {
-        matches!(
-            w,
-            Warning::Edges(topology::Warning::BlendIgnored {
-                kind: EdgeKind::Boundary,
-                ..
-            })
-        )
-    })
+    !w.iter()
+        .any(|w| matches!(w, Warning::NoProjectionPlane { .. }))
 }
 
 fn measure(s: &dyn Surface, topo: &Topology) -> ContinuityReport {

@@ -24,7 +24,7 @@ use std::str::FromStr;
 
 use crate::mesh::TriMesh;
 use crate::sharpness::EffectiveH;
-use crate::topology::{self, EdgeId, Topology};
+use crate::topology::{EdgeId, Topology};
 
 use super::coons::{Constituents, CoonsSurface};
 use super::hybrid::HybridSurface;
@@ -131,10 +131,12 @@ impl Default for SchemeParams {
 }
 
 /// A fallback taken while building a surface.
+///
+/// Edges a surface cannot blend (boundary, non-manifold, degenerate) are not among them: every
+/// surface is built from [`EffectiveH`], already 0 on those edges, and the sharpness stage and
+/// the geometry checks report them.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Warning {
-    /// About edges that cannot be blended (boundary, non-manifold, degenerate).
-    Edges(topology::Warning),
     /// Seed 001 found no usable projection plane for `edges` interior edges (first: `first`),
     /// so they were made creases (h = 0): their two triangles are too folded against each
     /// other or against their end normals for the Foley–Opitz construction.
@@ -144,7 +146,6 @@ pub enum Warning {
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Warning::Edges(w) => w.fmt(f),
             Warning::NoProjectionPlane { edges, first } => write!(
                 f,
                 "no projection plane for {edges} folded edge(s) (first: edge {}); they are creases",
