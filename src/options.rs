@@ -44,10 +44,10 @@ pub const DEFAULT_SCHEME: Scheme = Scheme::G2;
 /// side-vertex centre.
 pub const DEFAULT_NETS: Nets = Nets::Round;
 /// Default cap on output triangles per input file, so a typo in `level` cannot fill the disk or
-/// the memory: at the measured peak of about 35 bytes per output triangle for positions and
-/// normals, about 370 with regenerated tangents (plus about 320 per input triangle; the upper
+/// the memory: at the measured peak of about 32 bytes per output triangle for positions and
+/// normals, about 370 with regenerated tangents (plus about 240 per input triangle; the upper
 /// end is rounded up to [`crate::pipeline::PEAK_BYTES_PER_OUTPUT_TRIANGLE`]), 20 million
-/// triangles need 0.7 to 7 GiB, which leaves room for a desktop session and a second job on a
+/// triangles need 0.6 to 7 GiB, which leaves room for a desktop session and a second job on a
 /// 24 GiB machine.
 pub const DEFAULT_MAX_OUTPUT_TRIANGLES: u64 = 20_000_000;
 /// Default: `uri`s may not leave the asset's folder.

@@ -144,8 +144,8 @@ pub struct Args {
     #[arg(long, help_heading = "Output")]
     pub overdraw: bool,
 
-    /// Refuse outputs with more triangles than this per file (memory: about 35 bytes each, up to
-    /// 400 with UVs and generated tangents, plus about 320 per input triangle)
+    /// Refuse outputs with more triangles than this per file (memory: about 32 bytes each, up to
+    /// 400 with UVs and generated tangents, plus about 240 per input triangle)
     /// [default: 20000000]
     #[arg(
         long,
