@@ -36,6 +36,19 @@ pub struct Accessor<'a> {
 /// Components per task of a parallel scan ([`Accessor::find_first`]).
 pub(crate) const SCAN_BLOCK: usize = 1 << 14;
 
+/// The first index of `items` that passes `hit`, searched in parallel blocks of
+/// [`SCAN_BLOCK`] scanned one after another (a parallel search per item costs more than the
+/// test): the same first hit whatever the thread count.
+pub(crate) fn first_in_blocks<T: Sync>(
+    items: &[T],
+    hit: impl Fn(&T) -> bool + Sync,
+) -> Option<usize> {
+    items
+        .par_chunks(SCAN_BLOCK)
+        .enumerate()
+        .find_map_first(|(b, block)| Some(b * SCAN_BLOCK + block.iter().position(&hit)?))
+}
+
 /// Bytes per component.
 pub fn component_size(t: ComponentType) -> usize {
     match t {

@@ -9,7 +9,6 @@
 use gltf_json::accessor::{ComponentType, GenericComponentType, Type};
 use gltf_json::mesh::Mode;
 use gltf_json::validation::{Checked, USize64};
-use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 
 use super::accessor::{self, component_size, vector_type};
@@ -192,14 +191,7 @@ impl PrimitiveData {
                 ))
             }
         };
-        let first_bad = positions
-            .par_chunks(accessor::SCAN_BLOCK)
-            .enumerate()
-            .find_map_first(|(b, block)| {
-                let k = block.iter().position(|x| !x.is_finite())?;
-                Some(b * accessor::SCAN_BLOCK + k)
-            });
-        if let Some(i) = first_bad {
+        if let Some(i) = accessor::first_in_blocks(positions, |x| !x.is_finite()) {
             return Err(Error::invalid(
                 format!("{at}.attributes.POSITION"),
                 format!("vertex {} is not finite (expected finite numbers)", i / 3),

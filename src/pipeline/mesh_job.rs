@@ -451,12 +451,9 @@ fn prepare(
     let at = format!("meshes[{mesh}].primitives[{}]", input.index);
     let positions = data.positions(&at)?;
     let vertex_count = positions.len() / 3;
-    // In blocks: a parallel search per index costs more than the comparison.
-    let out_of_range = data
-        .indices
-        .par_chunks(1 << 14)
-        .find_map_first(|block| block.iter().find(|&&i| i as usize >= vertex_count));
-    if let Some(bad) = out_of_range {
+    let out_of_range =
+        gltf_io::accessor::first_in_blocks(&data.indices, |&i| i as usize >= vertex_count);
+    if let Some(bad) = out_of_range.map(|k| data.indices[k]) {
         return Err(gltf_io::Error::invalid(
             format!("{at}.indices"),
             format!("index {bad} is out of range (expected below the vertex count {vertex_count})"),

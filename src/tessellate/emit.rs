@@ -122,7 +122,7 @@ impl<'a> TriangleWriter<'a> {
         point: impl Fn(u32) -> usize,
         source: impl Fn(usize) -> VertexSource,
     ) {
-        let slot = |m: u32| first_slot + (if ascending { m } else { n - m } - 1) as usize;
+        let slot = |m: u32| edge_slot(first_slot, ascending, n, m);
         if !owned {
             for m in 1..n {
                 local[point(m)] = slot(m) as u32;
@@ -219,6 +219,15 @@ impl<'a> TriangleWriter<'a> {
             );
         }
     }
+}
+
+/// The output slot of sample `m` (1 to n − 1, counted from corner `(k + 1) % 3`) of an edge whose
+/// slots start at `first_slot` and run from its lower input vertex (`ascending`: that is corner
+/// `(k + 1) % 3`). One formula for the pass that evaluates the samples and the one that numbers
+/// the triangles after the surface is freed: they must agree slot for slot.
+#[inline]
+pub(super) fn edge_slot(first_slot: usize, ascending: bool, n: u32, m: u32) -> usize {
+    first_slot + (if ascending { m } else { n - m } - 1) as usize
 }
 
 /// Points in `part` of the level-`level` lattice (see [`LatticePart::points`]).

@@ -418,15 +418,7 @@ fn number_triangle(
         .sources
         .as_deref_mut()
         .expect("numbered blocks hold sources");
-    let source = |li: usize| {
-        let [i, j] = plan.lattice_ij[li];
-        VertexSource {
-            tri: tri as u32,
-            level: n as u8,
-            i,
-            j,
-        }
-    };
+    let source = |li: usize| plan.source(tri, li);
     for (c, &li) in plan.corners.iter().enumerate() {
         let slot = layout.corner_slot[3 * offset + c] as usize;
         local[li as usize] = slot as u32;
@@ -439,8 +431,7 @@ fn number_triangle(
         let ascending = corners[(k + 1) % 3] <= corners[(k + 2) % 3];
         let owned = owns & (8 << k) != 0;
         for m in 1..n {
-            // Sample m from corner k + 1, its slots run from the lower input vertex.
-            let slot = first_slot + (if ascending { m } else { n - m } - 1) as usize;
+            let slot = emit::edge_slot(first_slot, ascending, n, m);
             let li = lis[(m - 1) as usize] as usize;
             local[li] = slot as u32;
             if owned {
@@ -499,15 +490,7 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
             writer.evaluate_parts(tri, &parts);
         }
         // The level was checked once in `tessellate`, the coordinates come from its plan.
-        let source = |li: usize| {
-            let [i, j] = plan.lattice_ij[li];
-            VertexSource {
-                tri: tri as u32,
-                level: n as u8,
-                i,
-                j,
-            }
-        };
+        let source = |li: usize| plan.source(tri, li);
         for (c, &li) in plan.corners.iter().enumerate() {
             let slot = layout.corner_slot[3 * offset + c] as usize;
             let owned = owns & (1 << c) != 0;

@@ -41,6 +41,18 @@ pub(crate) struct LatticePlan {
 }
 
 impl LatticePlan {
+    /// Where local point `li` of source triangle `tri` comes from, on this plan's lattice.
+    #[inline]
+    pub fn source(&self, tri: usize, li: usize) -> super::VertexSource {
+        let [i, j] = self.lattice_ij[li];
+        super::VertexSource {
+            tri: tri as u32,
+            level: self.n as u8,
+            i,
+            j,
+        }
+    }
+
     /// The plan for level `n ≥ 1`.
     pub fn new(n: u32) -> LatticePlan {
         let len = lattice_len(n);
