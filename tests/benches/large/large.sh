@@ -9,7 +9,9 @@
 # a rotated order, so a slow spell of a busy machine falls on all of them alike. Prints the
 # median, the spread (worst / median), median user and sys time, the largest peak RSS, the cost
 # per input triangle and, for g2tess, the ratio to OpenSubdiv at the same output; writes the
-# figures as JSON and a plot of the cost per input triangle against the input size.
+# figures as JSON and a plot of the cost per input triangle against the input size. Each round
+# also runs g2tess on the bundled 20-triangle icosahedron, the fixed cost of a run, so that the
+# cost per input triangle is also given without it.
 #
 #   tests/benches/large/large.sh [--no-install]
 #
@@ -50,12 +52,18 @@ timed() { # size, label, factor, output file, command...
   local size=$1 label=$2 factor=$3 out=$4
   shift 4
   rm -f "$out"
-  /usr/bin/time -f '%e %U %S %M' -o "$WORK/time.txt" "$@" > /dev/null 2> "$WORK/stderr.txt" || {
+  # Wall time from bash's microsecond clock: GNU time's %e has a resolution of 10 ms, as long as
+  # a whole 10k run.
+  local start=$EPOCHREALTIME
+  /usr/bin/time -f '%U %S %M' -o "$WORK/time.txt" "$@" > /dev/null 2> "$WORK/stderr.txt" || {
     echo "failed: $*" >&2
     cat "$WORK/stderr.txt" >&2
     exit 1
   }
-  read -r wall user sys kib < <(tail -n 1 "$WORK/time.txt")
+  local end=$EPOCHREALTIME
+  local wall
+  wall=$(python3 -c "print(f'{$end - $start:.6f}')")
+  read -r user sys kib < <(tail -n 1 "$WORK/time.txt")
   printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$size" "$label" "$factor" "$wall" "$user" "$sys" \
     "$kib" "$(stat -c %s "$out")" >> "$RAW"
 }
@@ -70,7 +78,7 @@ for tris in $SIZES; do
   for level in $LEVELS; do
     case $level in 2) commands+=("osd 1") ;; 4) commands+=("osd 2") ;; esac
   done
-  commands+=("pack")
+  commands+=("pack" "start")
   echo "== $name ($actual triangles): ${#commands[@]} commands × $RUNS runs" >&2
   for run in $(seq "$RUNS"); do
     n=${#commands[@]}
@@ -81,6 +89,11 @@ for tris in $SIZES; do
               "$G2" "$WORK/$name.glb" -o "$WORK/out/g2.glb" --level "$2" --max-triangles 200000000 ;;
         osd) timed "$actual" "OpenSubdiv Loop level $2" $(( 1 << (2 * $2) )) "$WORK/out/osd.glb" \
               "$WORK/osd_loop" "$WORK/$name.raw" "$2" "$WORK/out/osd.glb" ;;
+        # The fixed cost of a run: the bundled 20-triangle icosahedron at level 1 (process
+        # start, reading, writing), taken in the same rounds so that the cost per input
+        # triangle can be given without it.
+        start) timed "$actual" "g2tess start-up" 1 "$WORK/out/start.glb" \
+              "$G2" "$ROOT/fixtures/icosahedron.glb" -o "$WORK/out/start.glb" --level 1 ;;
         pack) timed "$actual" "gltfpack -noq" 1 "$WORK/out/pack.glb" \
               "$PACK" -noq -i "$WORK/$name.glb" -o "$WORK/out/pack.glb" ;;
       esac

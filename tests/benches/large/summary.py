@@ -15,6 +15,10 @@ import statistics
 import sys
 
 
+# The label of the fixed-cost runs (`large.sh`): not a command on the input.
+START = "g2tess start-up"
+
+
 def main():
     raw, out_json, out_png, runs, load = sys.argv[1:6]
     rows = {}
@@ -58,6 +62,12 @@ def main():
     print("| ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for f in figures:
         ratio = ""
+        if f["command"] == START:
+            print(f"| 20 (bundled icosahedron, in the {f['input_triangles']:,} rounds) | "
+                  f"{f['command']} | 20 | {f['median_s']:.3f} | {f['min_s']:.3f}–{f['max_s']:.3f} | "
+                  f"{f['worst_over_median']:.2f} | {f['median_user_s']:.2f} | "
+                  f"{f['median_sys_s']:.2f} | {f['peak_mib']:.0f} | | | |")
+            continue
         if f["command"].startswith("g2tess"):
             level = int(f["command"].split()[-1])
             loop = {2: 1, 4: 2}.get(level)
@@ -71,7 +81,8 @@ def main():
               f"{f['us_per_input_triangle']:.3f} | {ratio} |")
 
     sizes = sorted({f["input_triangles"] for f in figures})
-    ours = sorted({f["command"] for f in figures if f["command"].startswith("g2tess")},
+    ours = sorted({f["command"] for f in figures
+                   if f["command"].startswith("g2tess") and f["command"] != START},
                   key=lambda c: int(c.split()[-1]))
     print()
     print("g2tess, µs of whole-process time per input triangle (median), and the largest over the "
@@ -83,6 +94,26 @@ def main():
         cells = [by_key[(s, c)]["us_per_input_triangle"] for s in sizes if (s, c) in by_key]
         spread = max(cells) / min(cells) if cells else float("nan")
         print(f"| {c} | " + " | ".join(f"{x:.3f}" for x in cells) + f" | {spread:.2f} |")
+
+    # The same without the fixed cost of a run (process start, reading and writing a 20-triangle
+    # file), measured in the same rounds as each size: what each added input triangle costs.
+    starts = {s: by_key[(s, START)]["median_s"] for s in sizes if (s, START) in by_key}
+    if starts:
+        print()
+        print("The same without the fixed cost of a run (the start-up row of the same rounds, "
+              "median " + ", ".join(f"{starts[s] * 1e3:.1f} ms" for s in sorted(starts)) + "):")
+        print()
+        print("| command | " + " | ".join(f"{s:,}" for s in sizes) + " | largest / smallest |")
+        print("| --- | " + " | ".join("---:" for _ in sizes) + " | ---: |")
+        for c in ours:
+            cells = [(by_key[(s, c)]["median_s"] - starts.get(s, 0.0)) / s * 1e6
+                     for s in sizes if (s, c) in by_key]
+            for s in sizes:
+                if (s, c) in by_key:
+                    by_key[(s, c)]["us_per_input_triangle_without_start"] = (
+                        (by_key[(s, c)]["median_s"] - starts.get(s, 0.0)) / s * 1e6)
+            spread = max(cells) / min(cells) if cells else float("nan")
+            print(f"| {c} | " + " | ".join(f"{x:.3f}" for x in cells) + f" | {spread:.2f} |")
 
     json.dump({"runs": int(runs), "load_before": float(load), "figures": figures},
               open(out_json, "w"), indent=1)
@@ -98,7 +129,7 @@ def plot(figures, path):
         print(f"(matplotlib missing: no plot written to {path})", file=sys.stderr)
         return
     fig, ax = plt.subplots(figsize=(7, 4.2), dpi=110)
-    commands = sorted({f["command"] for f in figures})
+    commands = sorted({f["command"] for f in figures if f["command"] != START})
     for c in commands:
         points = sorted((f["input_triangles"], f["us_per_input_triangle"])
                         for f in figures if f["command"] == c)
