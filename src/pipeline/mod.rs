@@ -249,6 +249,7 @@ fn smooth_meshes(
     let window = rayon::current_num_threads().max(1);
     let mut left = inputs.len();
     let mut inputs = inputs.into_iter();
+    let mut file_total = FileTotal::default();
     loop {
         let batch: Vec<MeshInput> = inputs.by_ref().take(window).collect();
         if batch.is_empty() {
@@ -260,9 +261,11 @@ fn smooth_meshes(
             .map(|m| smooth_one(m, &sharpness, options, asset))
             .collect();
         for out in outputs {
+            let out = out?;
+            file_total.add(&out, options, asset)?;
             // Storing the new arrays in the document's buffer is the first half of writing.
             let store_start = Instant::now();
-            let mesh_report = lod::store_with_msft_lod(doc, out?, asset)?;
+            let mesh_report = lod::store_with_msft_lod(doc, out, asset)?;
             left -= 1;
             step(doc, Step::Stored { last: left == 0 })?;
             report.times.write += store_start.elapsed().as_secs_f64();
@@ -270,6 +273,39 @@ fn smooth_meshes(
         }
     }
     Ok(report)
+}
+
+/// The output triangles of one file so far, for `--max-triangles`, which bounds a file. Uniform
+/// levels are checked against it from the declared counts before anything is decoded
+/// ([`check_output_size`]); per-edge counts (a tolerance, a budget, a LOD chain) are known only
+/// once a mesh's surface is built, so each mesh is refused there when it alone is over, and the
+/// file's meshes here, added in file order so that the error is the same on any thread count.
+#[derive(Default)]
+struct FileTotal {
+    triangles: u64,
+}
+
+impl FileTotal {
+    /// Adds every level `out` writes; an error once the file is over the limit.
+    fn add(&mut self, out: &MeshOutput, options: &Options, asset: &Path) -> Result<(), Error> {
+        let count = |prims: &[(usize, PrimitiveData)]| -> u64 {
+            prims.iter().map(|(_, p)| p.indices.len() as u64 / 3).sum()
+        };
+        let levels =
+            count(&out.primitives) + out.lods.iter().flatten().map(|l| count(l)).sum::<u64>();
+        self.triangles = self.triangles.saturating_add(levels);
+        let limit = options.max_output_triangles;
+        if self.triangles > limit {
+            return Err(Error::limit(
+                asset,
+                format!(
+                    "its meshes up to mesh {} would get {} triangles, over --max-triangles {limit}, which bounds a whole file (expected a larger tolerance, a smaller --triangle-budget or a larger --max-triangles)",
+                    out.report.mesh, self.triangles
+                ),
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// [`process_document`] for `--lod-files`: one document per level of the options' LOD chain,
@@ -282,6 +318,10 @@ pub fn process_document_per_level(
     let (mut report, outputs) = smooth_document(doc, asset, options)?;
     let store_start = Instant::now();
     let mut outputs: Vec<MeshOutput> = outputs.into_iter().collect::<Result<_, _>>()?;
+    let mut file_total = FileTotal::default();
+    for out in &outputs {
+        file_total.add(out, options, asset)?;
+    }
     let mut docs = Vec::new();
     for level in 0..options.lod_levels().len().max(1) {
         let mut copy = doc.clone();

@@ -626,3 +626,62 @@ fn real_fixtures_skins_morphs_instancing_budgets() {
         }
     }
 }
+
+/// `--max-triangles` bounds a file: with per-edge counts, known only once each mesh's surface
+/// is built, two meshes that each fit but together do not are refused, whatever the threads.
+#[test]
+fn max_triangles_bounds_the_whole_file_with_per_edge_counts() {
+    let dir = corpus::temp_dir();
+    let mut json: Value = serde_json::from_str(&gltf("cyl", None, &[cylinder()])).unwrap();
+    let mut twin = json["meshes"][0].clone();
+    twin["name"] = Value::from("cyl twin");
+    json["meshes"].as_array_mut().unwrap().push(twin);
+    json["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({ "mesh": 1 }));
+    let node = json["nodes"].as_array().unwrap().len() - 1;
+    json["scenes"][0]["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(Value::from(node));
+    let input = dir.path().join("twins.gltf");
+    std::fs::write(&input, json.to_string()).unwrap();
+    let out = dir.path().join("o.glb");
+    let mut options = Options::default();
+    options.tolerance = TOLERANCES[1];
+
+    let free = process_file(&input, &out, &options).unwrap();
+    assert_eq!(free.meshes.len(), 2);
+    let of = |m: &g2tess::pipeline::MeshReport| -> usize {
+        m.primitives.iter().map(|p| p.triangles_out).sum()
+    };
+    let each = of(&free.meshes[0]);
+    assert_eq!(each, of(&free.meshes[1]));
+    let total = free.triangles_out as u64;
+    assert_eq!(total, 2 * each as u64);
+    assert!(each > 8, "the tolerance must refine the cylinder");
+
+    options.max_output_triangles = total;
+    assert_eq!(
+        process_file(&input, &out, &options).unwrap().triangles_out,
+        free.triangles_out
+    );
+    options.max_output_triangles = total - 1;
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let e = pool
+            .install(|| process_file(&input, &out, &options))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!(
+                "its meshes up to mesh 1 would get {total} triangles"
+            )) && e.contains("--max-triangles"),
+            "{e}"
+        );
+    }
+}
