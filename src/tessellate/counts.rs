@@ -19,6 +19,7 @@
 //! It deliberately writes no vertex.
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
@@ -169,7 +170,13 @@ impl ChordErrors {
     ///    along the normal), where the counts settle at a quarter of the points of
     /// 2. the same at twice the pattern's resolution, which sees the blend bands narrower than
     ///    a lattice step (the height field at 1e-4 is 5% over the tolerance without it); once
-    ///    the counts have settled it checks each triangle once, and raises few;
+    ///    the counts have settled it checks each triangle once, and raises few. A triangle
+    ///    whose last check in stage 1 showed that this one would pass too is not checked again
+    ///    (with the same counts): its prediction plus what the finer lattice can change of it
+    ///    on a surface smooth at the scale of two lattice steps ([`Curvature::spread`],
+    ///    [`PatternModel::bound`]) is within the tolerance. On the 10k icosphere at the error
+    ///    level 16 reaches that is 8,766 of its 9,680 triangles, and the counts are the same
+    ///    as with every triangle checked;
     /// 3. measured at the chord module's sample points, on the triangles as written (positions
     ///    rounded to `f32`): every output triangle of patterns up to inner level 12, the corner
     ///    triangles of finer ones, where the blend's curvature varies on the scale of the
@@ -188,6 +195,9 @@ impl ChordErrors {
     ) -> SegmentCounts {
         let predicted = (tolerance - self.rounding).max(0.5 * tolerance);
         let mut counts = self.counts_with_margin(topo, predicted, cap, 1.0);
+        // Per triangle, the packed key of the pattern whose last check at its own resolution
+        // showed the finer check would pass too (0: none).
+        let resolved: Vec<AtomicU64> = (0..counts.inner.len()).map(|_| AtomicU64::new(0)).collect();
         for factor in [1, 2] {
             counts.raise_until_met(
                 topo,
@@ -199,16 +209,32 @@ impl ChordErrors {
                  (points, curvature): &mut (Vec<SurfacePoint>, Curvature),
                  kept: &[[f64; 3]],
                  keep: &mut Vec<[f64; 3]>| {
+                    let key = pack(model.key());
+                    if factor == 2 && resolved[tri].load(Ordering::Relaxed) == key {
+                        return PatternError::default();
+                    }
                     let level = check_level(model.inner(), factor);
                     // The lattice depends on the triangle and the level alone: a triangle checked
                     // again with only its edge counts raised reads the second differences it kept.
-                    if !curvature.restore(level, kept) {
+                    let read = !curvature.restore(level, kept);
+                    if read {
                         points.clear();
                         surface.evaluate_lattice(tri, level, points);
                         curvature.read(points, level);
                     }
-                    keep.extend_from_slice(curvature.values());
-                    model.error(curvature)
+                    let error = model.error(curvature);
+                    if factor == 1 {
+                        // The spread is needed where this check passes, or may pass when
+                        // restored with its inner level as it is (its inner lattice passes).
+                        if read && error.inner <= predicted {
+                            curvature.measure_spread(points);
+                        }
+                        let finer = model.bound(&error, curvature.spread());
+                        let skip = if finer.within(predicted) { key } else { 0 };
+                        resolved[tri].store(skip, Ordering::Relaxed);
+                    }
+                    curvature.keep(keep);
+                    error
                 },
             );
         }
@@ -270,6 +296,12 @@ impl ChordErrors {
         }
         best
     }
+}
+
+/// A pattern key as one nonzero number (every count is between 1 and 255).
+fn pack(key: PatternKey) -> u64 {
+    let [a, b, c] = key.edges.map(u64::from);
+    a | b << 16 | c << 32 | u64::from(key.inner) << 48
 }
 
 fn finite(x: f64) -> f64 {

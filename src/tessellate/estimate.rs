@@ -26,7 +26,7 @@
 use glam::DVec3;
 
 use super::chord::WEIGHTS;
-use super::transition::Pattern;
+use super::transition::{Pattern, PatternKey};
 use crate::surface::{lattice_index, SurfacePoint};
 
 /// Second differences of a level-`L` lattice at its interior points (`i, j ≥ 1`, `i + j < L`),
@@ -36,7 +36,19 @@ use crate::surface::{lattice_index, SurfacePoint};
 pub(crate) struct Curvature {
     level: u32,
     at: Vec<[f64; 3]>,
+    /// How far, at most, the second differences a check at twice this lattice's resolution
+    /// reads (scaled to this lattice's step) can lie from [`Curvature::at`]: see
+    /// [`Curvature::spread`].
+    spread: f64,
 }
+
+/// The largest of `|½ Σ_{a<b} w_a w_b|` over the sample weights: the most a unit change of
+/// every `Q_ab` changes a sample's predicted error (at the centroid, `½ · 3 · (1/3)²`).
+const WEIGHT_GAIN: f64 = 1.0 / 6.0;
+
+/// Relative allowance for the rounding of [`worst_abs`]'s sums against the bound
+/// `WEIGHT_GAIN · max |q|`, which filters the points that cannot change a maximum.
+const BOUND_SLACK: f64 = 1.0 + 1e-12;
 
 /// The interior point of the level-`l` lattice nearest barycentrics `b`, as an index among the
 /// interior points in lattice order.
@@ -55,25 +67,47 @@ fn interior_index(n: u32, i: u32, j: u32) -> usize {
 }
 
 impl Curvature {
-    /// The second differences read, in interior lattice order: what [`Curvature::restore`]
-    /// takes back.
-    pub fn values(&self) -> &[[f64; 3]] {
-        &self.at
+    /// Appends what [`Curvature::restore`] takes back: the second differences read, in
+    /// interior lattice order, then the spread.
+    pub fn keep(&self, into: &mut Vec<[f64; 3]>) {
+        into.extend_from_slice(&self.at);
+        into.push([self.spread, 0.0, 0.0]);
     }
 
-    /// Takes back the [`Curvature::values`] of a level-`level` lattice read before, when
-    /// `values` has that lattice's number of interior points (which differs from level to level);
-    /// whether it did. A lattice of the same triangle and level has the same values, bit for
-    /// bit, so restoring them stands for reading it again.
+    /// Takes back what [`Curvature::keep`] appended for a level-`level` lattice read before,
+    /// when `values` has that lattice's number of interior points (which differs from level to
+    /// level) and the spread; whether it did. A lattice of the same triangle and level has the
+    /// same values, bit for bit, so restoring them stands for reading it again.
     pub fn restore(&mut self, level: u32, values: &[[f64; 3]]) -> bool {
         let interior = (level.saturating_sub(1) * level.saturating_sub(2) / 2) as usize;
-        if level < 3 || values.len() != interior {
+        if level < 3 || values.len() != interior + 1 {
             return false;
         }
         self.level = level;
         self.at.clear();
-        self.at.extend_from_slice(values);
+        self.at.extend_from_slice(&values[..interior]);
+        self.spread = values[interior][0];
         true
+    }
+
+    /// A bound on how far the second differences of the lattice at twice this one's
+    /// resolution, times 4 (the step halved), lie from this lattice's at the points a model
+    /// reads, for a surface smooth at the scale of two steps; `∞` when this lattice is too
+    /// coarse to tell.
+    ///
+    /// With step `h` along a lattice direction `u`, `δ(h) = S(p − hu) − 2S(p) + S(p + hu)`
+    /// `= h² D²S[u,u] + (h⁴/12) D⁴S[u,u,u,u] + O(h⁶)`, so the finer check reads
+    /// `4δ(h/2) = δ(h) − Δ/4 + O(h⁶)` with `Δ = δ(2h)/4 − δ(h)` (Richardson: the stride-2
+    /// differences of this same lattice, no new evaluation). The finer lattice's model also
+    /// reads its points up to half a step from this one's, where the differences differ by at
+    /// most half the largest change `V` between neighbouring points. The spread is
+    /// `Δ_max/2 + V_max`: both terms twice what the expansion gives, for the higher orders. A
+    /// blend band narrower than a step, which the finer check exists for, breaks the expansion
+    /// and shows in both `Δ` and `V` as differences of the size of the second differences
+    /// themselves, so its spread is large and the finer check runs. NaN until
+    /// [`Curvature::measure_spread`] measured it (no bound passes then).
+    pub fn spread(&self) -> f64 {
+        self.spread
     }
 
     /// Reads the second differences of `points`, the whole level-`level` lattice (`level ≥ 3`)
@@ -94,6 +128,57 @@ impl Curvature {
                     along(at(i + 1, j - 1) - centre + at(i - 1, j + 1)),
                 ]);
             }
+        }
+        self.spread = f64::NAN;
+    }
+
+    /// Measures [`Curvature::spread`] on `points`, the lattice [`Curvature::read`] read last:
+    /// apart, as only a check that may skip the finer one needs it.
+    pub fn measure_spread(&mut self, points: &[SurfacePoint]) {
+        self.spread = self.spread_of(points);
+    }
+
+    /// [`Curvature::spread`] of the lattice `points` whose second differences `at` holds.
+    fn spread_of(&self, points: &[SurfacePoint]) -> f64 {
+        let level = self.level;
+        if level < 6 {
+            return f64::INFINITY;
+        }
+        let at = |i: u32, j: u32| points[lattice_index(level, i, j)].position;
+        let mut richardson = 0.0f64;
+        let mut change = 0.0f64;
+        let mut index = 0;
+        for j in 1..level {
+            for i in 1..level - j {
+                let fine = self.at[index];
+                if i >= 2 && j >= 2 && i + j + 2 <= level {
+                    let p = &points[lattice_index(level, i, j)];
+                    let centre = 2.0 * p.position;
+                    let along = |d: DVec3| 0.25 * d.dot(p.normal);
+                    let coarse = [
+                        along(at(i - 2, j) - centre + at(i + 2, j)),
+                        along(at(i, j - 2) - centre + at(i, j + 2)),
+                        along(at(i + 2, j - 2) - centre + at(i - 2, j + 2)),
+                    ];
+                    for k in 0..3 {
+                        richardson = richardson.max((coarse[k] - fine[k]).abs());
+                    }
+                }
+                // The neighbours (i + 1, j) and (i, j + 1), when interior.
+                if i + j + 1 < level {
+                    for other in [self.at[index + 1], self.at[interior_index(level, i, j + 1)]] {
+                        for k in 0..3 {
+                            change = change.max((other[k] - fine[k]).abs());
+                        }
+                    }
+                }
+                index += 1;
+            }
+        }
+        if richardson.is_finite() && change.is_finite() {
+            0.5 * richardson + change
+        } else {
+            f64::INFINITY
         }
     }
 
@@ -116,7 +201,11 @@ impl Curvature {
         for j in 1..l {
             for i in 1..l - j {
                 if inside(i, j) {
-                    worst = worst.max(worst_abs(self.at[index]));
+                    let q = self.at[index];
+                    // A point whose bound is under the largest error so far cannot change it.
+                    if bound(q) > worst {
+                        worst = worst.max(worst_abs(q));
+                    }
                 }
                 index += 1;
             }
@@ -125,22 +214,29 @@ impl Curvature {
         scale * worst
     }
 
-    /// The predicted error of one output triangle of a model, at the second differences of
-    /// the interior points nearest its corners (found when the model was built).
-    fn triangle_error(&self, t: &ModelTriangle) -> f64 {
-        debug_assert_eq!(t.level, self.level, "the model was built for this lattice");
+    /// The predicted error of one output triangle of a model at one of the interior points
+    /// nearest its corners (found when the model was built), or any value at most `floor` when
+    /// it is at most `floor` (its bound is then all it computes: the caller keeps a maximum
+    /// that is at least `floor`).
+    fn sample_error(&self, s: &ModelSample, floor: f64) -> f64 {
         let l2 = f64::from(self.level).powi(2);
-        let mut worst = 0.0f64;
-        for &p in t.nearest.iter().filter(|&&p| p != u32::MAX) {
-            let [d1, d2, d3] = self.at[p as usize];
-            let mixed = d1 + d2 - d3;
-            let q = t
-                .edges
-                .map(|[ii, jj, ij]| l2 * (ii * d1 + jj * d2 + ij * mixed));
-            worst = worst.max(worst_abs(q));
+        let [d1, d2, d3] = self.at[s.point as usize];
+        let mixed = d1 + d2 - d3;
+        let q = s
+            .edges
+            .map(|[ii, jj, ij]| l2 * (ii * d1 + jj * d2 + ij * mixed));
+        if bound(q) > floor {
+            worst_abs(q)
+        } else {
+            0.0
         }
-        worst
     }
+}
+
+/// An upper bound of [`worst_abs`]`(q)`, by [`WEIGHT_GAIN`], with room for its rounding.
+#[inline]
+fn bound(q: [f64; 3]) -> f64 {
+    WEIGHT_GAIN * BOUND_SLACK * q[0].abs().max(q[1].abs()).max(q[2].abs())
 }
 
 /// The largest error over the sample weights for `q = [Q_01, Q_12, Q_02]` (normal components).
@@ -152,17 +248,19 @@ fn worst_abs(q: [f64; 3]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// An output triangle of a pattern that touches the source triangle's boundary.
+/// One output triangle of a pattern that touches the source triangle's boundary, at one of the
+/// interior points of the model's lattice nearest its corners (where its error is read). The
+/// triangles of a pattern's rings repeat a few shapes, and neighbours share nearest points: a
+/// model holds each (point, shape) once, touching the union of the edges its triangles touch,
+/// which leaves the largest error per edge as it is and reads about a third as many.
 #[derive(Debug, Clone)]
-struct ModelTriangle {
-    /// The lattice level the model reads.
-    level: u32,
-    /// The interior points of that lattice nearest its corners, each once (`u32::MAX` for a
-    /// repeat): where its second differences are read.
-    nearest: [u32; 3],
-    /// For its edges (corners 0–1, 1–2, 0–2) with domain vector `(d_i, d_j)`: `(d_i², d_j², d_i d_j)`.
+struct ModelSample {
+    /// Index of the point among the lattice's interior points.
+    point: u32,
+    /// For the triangle's edges (corners 0–1, 1–2, 0–2) with domain vector `(d_i, d_j)`:
+    /// `(d_i², d_j², d_i d_j)`.
     edges: [[f64; 3]; 3],
-    /// The source triangle's edges it touches (bit `k`: edge `k`).
+    /// The source triangle's edges its triangles touch (bit `k`: edge `k`).
     touches: u8,
 }
 
@@ -170,8 +268,15 @@ struct ModelTriangle {
 /// differ in shape), its inner lattice as a whole.
 #[derive(Debug, Clone)]
 pub(crate) struct PatternModel {
-    inner: u32,
-    boundary: Vec<ModelTriangle>,
+    key: PatternKey,
+    level: u32,
+    boundary: Vec<ModelSample>,
+    /// Per edge, how much the predicted error of its triangles can grow per unit of
+    /// [`Curvature::spread`]: each second difference `δ_k` off by at most `s` moves
+    /// `Q_e = L²(ii δ₁ + jj δ₂ + ij (δ₁ + δ₂ − δ₃))` by at most
+    /// `s L² (|ii + ij| + |jj + ij| + |ij|)`, and the error by at most `WEIGHT_GAIN` times the
+    /// largest of those; the largest over the triangles touching the edge.
+    edge_gains: [f64; 3],
 }
 
 /// The predicted errors of one source triangle's pattern.
@@ -183,55 +288,109 @@ pub(crate) struct PatternError {
     pub edges: [f64; 3],
 }
 
+impl PatternError {
+    /// Whether every part is at or below `tolerance`.
+    pub fn within(&self, tolerance: f64) -> bool {
+        self.inner <= tolerance && self.edges.iter().all(|&e| e <= tolerance)
+    }
+}
+
 impl PatternModel {
     /// The model of `pattern` over the second differences of a level-`level` lattice (`level`
     /// at least 3 and at least the pattern's inner level).
     pub fn new(pattern: &Pattern, level: u32) -> PatternModel {
-        let boundary = (0..pattern.triangles.len())
-            .filter_map(|t| {
-                let touches = pattern.touches(t);
-                if touches == 0 {
-                    return None;
+        let l2 = f64::from(level).powi(2);
+        let mut edge_gains = [0.0f64; 3];
+        let mut boundary = Vec::new();
+        for t in 0..pattern.triangles.len() {
+            let touches = pattern.touches(t);
+            if touches == 0 {
+                continue;
+            }
+            let corners = pattern.triangles[t].map(|p| pattern.bary(p));
+            let edge = |a: usize, b: usize| {
+                let (di, dj) = (corners[a][1] - corners[b][1], corners[a][2] - corners[b][2]);
+                [di * di, dj * dj, di * dj]
+            };
+            let edges = [edge(0, 1), edge(1, 2), edge(0, 2)];
+            let gain = WEIGHT_GAIN
+                * edges
+                    .iter()
+                    .map(|&[ii, jj, ij]| {
+                        l2 * ((ii + ij).abs() + (jj + ij).abs() + ij.abs()) * BOUND_SLACK
+                    })
+                    .fold(0.0, f64::max);
+            for (k, g) in edge_gains.iter_mut().enumerate() {
+                if touches & (1 << k) != 0 {
+                    *g = g.max(gain);
                 }
-                let corners = pattern.triangles[t].map(|p| pattern.bary(p));
-                let edge = |a: usize, b: usize| {
-                    let (di, dj) = (corners[a][1] - corners[b][1], corners[a][2] - corners[b][2]);
-                    [di * di, dj * dj, di * dj]
-                };
-                let mut nearest = corners.map(|b| nearest(level, b) as u32);
-                for c in 1..3 {
-                    if nearest[..c].contains(&nearest[c]) {
-                        nearest[c] = u32::MAX;
-                    }
-                }
-                Some(ModelTriangle {
-                    level,
-                    nearest,
-                    edges: [edge(0, 1), edge(1, 2), edge(0, 2)],
+            }
+            for b in corners {
+                boundary.push(ModelSample {
+                    point: nearest(level, b) as u32,
+                    edges,
                     touches,
-                })
-            })
-            .collect();
+                });
+            }
+        }
+        let same_key = |s: &ModelSample| (s.point, s.edges.map(|e| e.map(f64::to_bits)));
+        boundary.sort_by_key(same_key);
+        boundary.dedup_by(|later, kept| {
+            let same = same_key(later) == same_key(kept);
+            if same {
+                kept.touches |= later.touches;
+            }
+            same
+        });
         PatternModel {
-            inner: pattern.key.inner,
+            key: pattern.key,
+            level,
             boundary,
+            edge_gains,
         }
     }
 
     /// The inner level of its pattern.
     pub fn inner(&self) -> u32 {
-        self.inner
+        self.key.inner
+    }
+
+    /// The key of its pattern.
+    pub fn key(&self) -> PatternKey {
+        self.key
+    }
+
+    /// An upper bound of the errors the same model predicts from any lattice whose second
+    /// differences lie within `spread` of those `error` was predicted from
+    /// ([`PatternModel::error`]): each part grows by at most its gain times `spread`. The inner
+    /// lattice's error is `(L/m)²` times the worst over its points, each moving by at most
+    /// `WEIGHT_GAIN · spread`.
+    pub fn bound(&self, error: &PatternError, spread: f64) -> PatternError {
+        let scale = (f64::from(self.level) / f64::from(self.key.inner)).powi(2);
+        PatternError {
+            inner: error.inner + scale * WEIGHT_GAIN * BOUND_SLACK * spread,
+            edges: [0, 1, 2].map(|k| error.edges[k] + self.edge_gains[k] * spread),
+        }
     }
 
     /// The predicted errors of this pattern over the surface whose second differences are
     /// `curvature` (a lattice of level at least the pattern's inner level).
     pub fn error(&self, curvature: &Curvature) -> PatternError {
         let mut out = PatternError {
-            inner: curvature.lattice_error(self.inner),
+            inner: curvature.lattice_error(self.key.inner),
             edges: [0.0; 3],
         };
+        debug_assert_eq!(
+            curvature.level, self.level,
+            "the model was built for this lattice"
+        );
         for t in &self.boundary {
-            let e = curvature.triangle_error(t);
+            // The smallest maximum this sample could raise.
+            let floor = (0..3)
+                .filter(|k| t.touches & (1 << k) != 0)
+                .map(|k| out.edges[k])
+                .fold(f64::INFINITY, f64::min);
+            let e = curvature.sample_error(t, floor);
             for (k, edge) in out.edges.iter_mut().enumerate() {
                 if t.touches & (1 << k) != 0 {
                     *edge = edge.max(e);
@@ -239,5 +398,208 @@ impl PatternModel {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::{lattice_bary, lattice_len};
+
+    /// The level-`n` lattice of the height field `z = f(x, y)` over the equilateral triangle
+    /// of side `side`, with exact unit normals.
+    fn height_lattice(
+        n: u32,
+        side: f64,
+        f: impl Fn(f64, f64) -> (f64, f64, f64),
+    ) -> Vec<SurfacePoint> {
+        let mut points = vec![
+            SurfacePoint {
+                position: DVec3::ZERO,
+                normal: DVec3::Z,
+            };
+            lattice_len(n)
+        ];
+        for j in 0..=n {
+            for i in 0..=n - j {
+                let b = lattice_bary(n, i, j);
+                let (x, y) = (side * (b[1] + 0.5 * b[2]), side * 0.75f64.sqrt() * b[2]);
+                let (z, fx, fy) = f(x, y);
+                points[lattice_index(n, i, j)] = SurfacePoint {
+                    position: DVec3::new(x, y, z),
+                    normal: DVec3::new(-fx, -fy, 1.0).normalize(),
+                };
+            }
+        }
+        points
+    }
+
+    fn curvature(points: &[SurfacePoint], level: u32) -> Curvature {
+        let mut c = Curvature::default();
+        c.read(points, level);
+        c.measure_spread(points);
+        c
+    }
+
+    /// A height field: `(x, y) ↦ (z, ∂z/∂x, ∂z/∂y)`.
+    type Field = Box<dyn Fn(f64, f64) -> (f64, f64, f64)>;
+
+    /// Smooth height fields (quadratic plus quartic and oscillating terms, wavelengths from
+    /// 3 to 12 triangle sides), so that the finer lattice's prediction differs from the
+    /// coarser one's by the higher orders the spread allows for.
+    fn smooth_fields() -> Vec<Field> {
+        vec![
+            Box::new(|x, y| {
+                let z = 0.4 * (x * x + y * y) + 0.3 * x.powi(4);
+                (z, 0.8 * x + 1.2 * x.powi(3), 0.8 * y)
+            }),
+            Box::new(|x, y| {
+                let (kx, ky) = (2.0, 1.3);
+                let z = 0.2 * (kx * x).sin() * (ky * y).cos();
+                (
+                    z,
+                    0.2 * kx * (kx * x).cos() * (ky * y).cos(),
+                    -0.2 * ky * (kx * x).sin() * (ky * y).sin(),
+                )
+            }),
+            Box::new(|x, y| {
+                let z = 0.05 * (x * x - 0.5 * y * y) + 0.02 * (x * y).powi(2);
+                (z, 0.1 * x + 0.04 * x * y * y, -0.05 * y + 0.04 * x * x * y)
+            }),
+        ]
+    }
+
+    fn keys() -> Vec<PatternKey> {
+        [
+            ([8, 8, 8], 8),
+            ([5, 8, 7], 8),
+            ([12, 9, 10], 12),
+            ([6, 6, 6], 6),
+            ([9, 8, 5], 9),
+        ]
+        .map(|(edges, inner)| PatternKey { edges, inner })
+        .to_vec()
+    }
+
+    /// What the stage-2 skip rests on: the errors a model predicts from the lattice at twice
+    /// the resolution are at most [`PatternModel::bound`] of those predicted from the pattern's
+    /// own lattice with its spread, on smooth surfaces; and without the spread they are not
+    /// (the finer lattice does see more), so the bound is not vacuous.
+    #[test]
+    fn the_spread_bounds_the_check_at_twice_the_resolution() {
+        let mut exceeded_without_spread = 0;
+        for f in smooth_fields() {
+            for key in keys() {
+                let pattern = Pattern::new(key);
+                let (coarse_level, fine_level) = (key.inner.max(6), 2 * key.inner);
+                let coarse = curvature(&height_lattice(coarse_level, 1.0, &f), coarse_level);
+                let fine = curvature(&height_lattice(fine_level, 1.0, &f), fine_level);
+                let coarse_model = PatternModel::new(&pattern, coarse_level);
+                let fine_model = PatternModel::new(&pattern, fine_level);
+                let predicted = coarse_model.error(&coarse);
+                let bound = coarse_model.bound(&predicted, coarse.spread());
+                let finer = fine_model.error(&fine);
+                assert!(coarse.spread().is_finite());
+                assert!(
+                    finer.inner <= bound.inner,
+                    "{key:?}: {finer:?} over {bound:?}"
+                );
+                for k in 0..3 {
+                    assert!(
+                        finer.edges[k] <= bound.edges[k],
+                        "{key:?}: {finer:?} over {bound:?}"
+                    );
+                    exceeded_without_spread += usize::from(finer.edges[k] > predicted.edges[k]);
+                }
+                exceeded_without_spread += usize::from(finer.inner > predicted.inner);
+            }
+        }
+        assert!(exceeded_without_spread > 0, "the spread never mattered");
+    }
+
+    /// A blend band about a lattice step wide (a `tanh` ridge of width a fifth of the
+    /// triangle, on a level-8 lattice) is what the check at twice the resolution exists for:
+    /// its spread must be of the size of the second differences, not of the higher orders.
+    #[test]
+    fn a_band_about_a_step_wide_has_a_spread_of_its_curvature_size() {
+        let ridge = |x: f64, y: f64| {
+            let w = 0.2;
+            let t = ((x - 0.45) / w).tanh();
+            let dz = 0.01 * (1.0 - t * t) / w;
+            (0.01 * t, dz, 0.0 * y)
+        };
+        let level = 8;
+        let c = curvature(&height_lattice(level, 1.0, ridge), level);
+        let largest =
+            c.at.iter()
+                .flat_map(|q| q.map(f64::abs))
+                .fold(0.0, f64::max);
+        assert!(
+            c.spread() > 0.25 * largest,
+            "{} against {largest}",
+            c.spread()
+        );
+    }
+
+    /// The filters of [`Curvature::lattice_error`] and [`PatternModel::error`] (points whose
+    /// bound cannot change a maximum, samples shared by several triangles read once) leave the
+    /// result as the plain maximum over every boundary triangle and every nearest point, bit for
+    /// bit.
+    #[test]
+    fn the_filtered_error_is_the_plain_maximum() {
+        for f in smooth_fields() {
+            for key in keys() {
+                let pattern = Pattern::new(key);
+                for level in [key.inner.max(6), 2 * key.inner] {
+                    let c = curvature(&height_lattice(level, 1.0, &f), level);
+                    let error = PatternModel::new(&pattern, level).error(&c);
+                    let l2 = f64::from(level).powi(2);
+                    let mut plain = PatternError::default();
+                    let (l, m) = (level, key.inner);
+                    let mut index = 0;
+                    for j in 1..l {
+                        for i in 1..l - j {
+                            if m == l || (i * m >= l && j * m >= l && (l - i - j) * m >= l) {
+                                plain.inner = plain.inner.max(worst_abs(c.at[index]));
+                            }
+                            index += 1;
+                        }
+                    }
+                    plain.inner *= (f64::from(l) / f64::from(m)).powi(2);
+                    for t in 0..pattern.triangles.len() {
+                        let touches = pattern.touches(t);
+                        let corners = pattern.triangles[t].map(|p| pattern.bary(p));
+                        let edge = |a: usize, b: usize| {
+                            let (di, dj) =
+                                (corners[a][1] - corners[b][1], corners[a][2] - corners[b][2]);
+                            [di * di, dj * dj, di * dj]
+                        };
+                        let edges = [edge(0, 1), edge(1, 2), edge(0, 2)];
+                        for b in corners {
+                            let [d1, d2, d3] = c.at[nearest(level, b)];
+                            let q = edges
+                                .map(|[ii, jj, ij]| l2 * (ii * d1 + jj * d2 + ij * (d1 + d2 - d3)));
+                            for k in 0..3 {
+                                if touches & (1 << k) != 0 {
+                                    plain.edges[k] = plain.edges[k].max(worst_abs(q));
+                                }
+                            }
+                        }
+                    }
+                    assert_eq!(
+                        error.inner.to_bits(),
+                        plain.inner.to_bits(),
+                        "{key:?} at {level}"
+                    );
+                    for k in 0..3 {
+                        assert_eq!(
+                            error.edges[k].to_bits(),
+                            plain.edges[k].to_bits(),
+                            "{key:?} at {level}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }
