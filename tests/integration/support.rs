@@ -176,6 +176,26 @@ pub fn torus(n: usize) -> TriMesh {
     mesh
 }
 
+/// A closed torus of major radius 1 and minor radius `minor`, `nu` quads around the ring and
+/// `nv` around the tube, with analytic normals.
+pub fn torus_rings(nu: usize, nv: usize, minor: f64) -> TriMesh {
+    let mut mesh = TriMesh::default();
+    for j in 0..nv {
+        for i in 0..nu {
+            let (a, b) = (
+                std::f64::consts::TAU * i as f64 / nu as f64,
+                std::f64::consts::TAU * j as f64 / nv as f64,
+            );
+            let c = DVec3::new(a.cos(), a.sin(), 0.0);
+            let nrm = c * b.cos() + DVec3::Z * b.sin();
+            mesh.positions.push(c + minor * nrm);
+            mesh.normals.push(nrm);
+        }
+    }
+    grid_triangles(&mut mesh, nu, nv, true);
+    mesh
+}
+
 fn grid_triangles(mesh: &mut TriMesh, nu: usize, nv: usize, wrap: bool) {
     let (cu, cv) = if wrap { (nu, nv) } else { (nu + 1, nv + 1) };
     let id = |i: usize, j: usize| ((j % cv) * cu + (i % cu)) as u32;
