@@ -159,20 +159,26 @@ pub fn flat_grid(n: usize) -> TriMesh {
 
 /// A closed torus (major radius 1, minor 0.4) of `n`×`n` quads with analytic normals.
 pub fn torus(n: usize) -> TriMesh {
+    torus_rings(n, n, 0.4)
+}
+
+/// A closed torus of major radius 1 and minor radius `minor`, `nu` quads around the ring and
+/// `nv` around the tube, with analytic normals.
+pub fn torus_rings(nu: usize, nv: usize, minor: f64) -> TriMesh {
     let mut mesh = TriMesh::default();
-    for j in 0..n {
-        for i in 0..n {
+    for j in 0..nv {
+        for i in 0..nu {
             let (a, b) = (
-                std::f64::consts::TAU * i as f64 / n as f64,
-                std::f64::consts::TAU * j as f64 / n as f64,
+                std::f64::consts::TAU * i as f64 / nu as f64,
+                std::f64::consts::TAU * j as f64 / nv as f64,
             );
             let c = DVec3::new(a.cos(), a.sin(), 0.0);
             let nrm = c * b.cos() + DVec3::Z * b.sin();
-            mesh.positions.push(c + 0.4 * nrm);
+            mesh.positions.push(c + minor * nrm);
             mesh.normals.push(nrm);
         }
     }
-    grid_triangles(&mut mesh, n, n, true);
+    grid_triangles(&mut mesh, nu, nv, true);
     mesh
 }
 

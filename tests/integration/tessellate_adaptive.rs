@@ -212,6 +212,49 @@ fn flat_and_curved_parts_need_at_most_half_the_uniform_triangles() {
 }
 
 #[test]
+fn a_torus_fills_triangles_flat_along_the_ring_from_their_edges() {
+    // On a 50×20 torus (minor radius 0.35) at 1e-3 the tube and diagonal edges need about three
+    // segments and the ring edges one: uniform level 2 misses the tolerance, so the uniform
+    // lattice needs level 3, nine triangles per source triangle, and so does a pattern whose
+    // inner level is at least its largest edge count. With inner levels below the edges the
+    // triangles flat along the ring are filled from their edge samples (five triangles for
+    // 3 + 3 + 1): measured 13,500 triangles, 0.75 of level 3's 18,000.
+    let mesh = torus_rings(50, 20, 0.35);
+    let tolerance = 1e-3;
+    let r = run(&mesh, 0.2, tolerance, 64);
+    let adaptive = r.dense.indices.len() / 3;
+    let topo = &r.topo;
+    let below = (0..mesh.triangles.len())
+        .filter(|&t| {
+            let edges = topo.tri_edges[t].map(|e| r.counts.edges[e.0 as usize]);
+            r.counts.inner[t] < edges.into_iter().max().unwrap()
+        })
+        .count();
+    let hs = h_all(topo, 0.2);
+    let surface = G2Surface::new(&mesh, topo, &hs, Profile::C2);
+    let group = 0..mesh.triangles.len();
+    let level2 = tessellate(&mesh, topo, &hs, &surface, 2, std::slice::from_ref(&group));
+    let uniform2 = chord_error(
+        topo,
+        &surface,
+        &SegmentCounts::uniform(topo, 2),
+        group,
+        &level2[0],
+    );
+    println!(
+        "torus 50×20 at {tolerance:e}: {adaptive} triangles (measured {:.3e}), {below} with the inner level below an edge; level 2 measures {uniform2:.3e}",
+        r.measured
+    );
+    assert!(r.measured <= tolerance, "{}", r.measured);
+    assert!(uniform2 > tolerance, "level 2 meets it: {uniform2}");
+    assert!(below > 0);
+    assert!(
+        adaptive * 5 <= mesh.triangles.len() * 9 * 4,
+        "{adaptive} triangles: over 0.8 of uniform level 3"
+    );
+}
+
+#[test]
 fn watertight_at_every_tolerance() {
     let meshes = [
         ("torus", torus(10)),
