@@ -23,7 +23,8 @@ use crate::gltf_io::{self, semantic, PrimitiveData, Values};
 use crate::mesh::TriMesh;
 use crate::options::Options;
 use crate::sharpness::{AssetSharpness, EdgeParams, EffectiveH, MeshContext, PrimitiveContext};
-use crate::surface::{scheme, Surface};
+use crate::surface::flat::flat_is_exact;
+use crate::surface::{scheme, FlatSurface, Scheme, Surface};
 use crate::topology::Topology;
 use crate::{normals, optimize};
 
@@ -200,7 +201,15 @@ pub fn smooth_mesh(
     } = params;
     drop((h, sources));
 
-    let (surface, surface_warnings) = build_surface(options, &mesh, &topo, &effective);
+    // One level, or every level of the LOD chain from the one surface: only the counts and
+    // the tessellation are per level.
+    // The sidecar's density keys apply to each level as to one: a block that decides its
+    // mesh's density fixes it at every level.
+    let chain = sharpness.mesh_lod_levels(input.mesh, options);
+    // Only a single uniform level 1 with nothing measured reads corners alone.
+    let corners_only =
+        chain.is_empty() && !options.adaptive() && level == 1 && !options.report_figures;
+    let (surface, surface_warnings) = surface_for(options, corners_only, &mesh, &topo, &effective);
     report.warnings.0.extend(
         surface_warnings
             .iter()
@@ -214,11 +223,6 @@ pub fn smooth_mesh(
     report.times.surface = lap(&clock, report.times.sharpness);
     stop_if_cancelled(options, asset)?;
 
-    // One level, or every level of the LOD chain from the one surface: only the counts and
-    // the tessellation are per level.
-    // The sidecar's density keys apply to each level as to one: a block that decides its
-    // mesh's density fixes it at every level.
-    let chain = sharpness.mesh_lod_levels(input.mesh, options);
     let is_chain = !chain.is_empty();
     let levels = if chain.is_empty() {
         vec![options.clone()]
@@ -434,6 +438,29 @@ pub(super) fn build_surface<'a>(
 ) -> (Box<dyn Surface + 'a>, Vec<scheme::Warning>) {
     let params = options.scheme_params();
     scheme::build_surface(options.scheme, mesh, topo, h, &params)
+}
+
+/// The surface to tessellate `mesh` on, with the warnings its construction gave: the one the
+/// options ask for, or, when the tessellation reads `corners_only` (a uniform level 1), the
+/// flat surface wherever no output bit can tell them apart.
+///
+/// At level 1 every output vertex is an input corner, written from the mesh itself (its
+/// position and normalized normal) without asking the surface unless the normal has no
+/// direction ([`crate::surface::flat`]). The G² and PN nets would then be built (about a third
+/// of a level-1 run on a million triangles) and never read. Hybrid and Coons surfaces are
+/// still built: their construction reports folded edges, which a run prints.
+pub(super) fn surface_for<'a>(
+    options: &Options,
+    corners_only: bool,
+    mesh: &'a TriMesh,
+    topo: &'a Topology,
+    h: &'a EffectiveH,
+) -> (Box<dyn Surface + 'a>, Vec<scheme::Warning>) {
+    let interpolates_silently = matches!(options.scheme, Scheme::G2 | Scheme::Pn);
+    if corners_only && interpolates_silently && flat_is_exact(mesh) {
+        return (Box::new(FlatSurface::new(mesh)), Vec::new());
+    }
+    build_surface(options, mesh, topo, h)
 }
 
 /// Checks a primitive's positions and normals, generating normals where there are none.

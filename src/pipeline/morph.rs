@@ -55,7 +55,9 @@ pub fn targets(
     let mut warnings = Vec::new();
     for t in 0..count {
         let moved = displaced(mesh, prepared, t);
-        let (surface, said) = super::mesh_job::build_surface(options, &moved, topo, h);
+        // At a uniform level 1 the targets' output is their corners, as the base mesh's.
+        let corners_only = matches!(density, Density::Level(1));
+        let (surface, said) = super::mesh_job::surface_for(options, corners_only, &moved, topo, h);
         warnings.extend(said.into_iter().map(|w| (t, w)));
         let dense = density
             .tessellate(&moved, topo, h, surface.as_ref(), groups)

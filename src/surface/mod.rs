@@ -37,6 +37,7 @@
 
 pub mod blend;
 pub mod coons;
+pub mod flat;
 mod g2;
 pub mod hybrid;
 pub mod lattice_cache;
@@ -52,6 +53,7 @@ use glam::DVec3;
 use crate::mesh::TriMesh;
 use crate::topology::Topology;
 
+pub use flat::FlatSurface;
 pub use g2::{G2Surface, PnSurface};
 pub use nets::Nets;
 pub use profile::Profile;

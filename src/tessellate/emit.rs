@@ -122,6 +122,10 @@ impl<'a> TriangleWriter<'a> {
         point: impl Fn(u32) -> usize,
         source: impl Fn(usize) -> VertexSource,
     ) {
+        // No samples (one segment): nothing to number, and no surface to set up for none.
+        if n <= 1 {
+            return;
+        }
         let slot = |m: u32| edge_slot(first_slot, ascending, n, m);
         if !owned {
             for m in 1..n {

@@ -477,10 +477,11 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
         let corners = mesh.triangles[tri];
         let owns = layout.owns[offset];
         // Every part this triangle evaluates, in one call: its owned edges and its interior.
+        // At level 1 an edge has no samples: nothing is asked of the surface.
         parts.clear();
         parts.extend(
             (0..3u8)
-                .filter(|&k| owns & (8 << k) != 0)
+                .filter(|&k| n > 1 && owns & (8 << k) != 0)
                 .map(|k| (n, LatticePart::Edge(k))),
         );
         if plan.interior > 0 {

@@ -302,3 +302,39 @@ fn closed_assets_stay_closed_and_open_ones_gain_no_boundary() {
         );
     }
 }
+
+/// At level 1 the G² and PN schemes tessellate on the flat surface (their nets would never be
+/// read); a report's figures need the scheme's own surface. The output must be the same bytes
+/// either way: with morph targets, skins, split normals, several primitives and primitives
+/// without normals (generated at the crease angle).
+#[test]
+fn level_one_writes_the_same_bytes_with_and_without_the_schemes_surface() {
+    let Some(corpus) = corpus::fixtures_real() else {
+        return;
+    };
+    let assets = [
+        "valid/AnimatedMorphCube/AnimatedMorphCube.gltf",
+        "valid/MorphPrimitivesTest/MorphPrimitivesTest.gltf",
+        "valid/MultiPrimCustomAttribute/23_multi_prim_vertex_attribute.gltf",
+        "valid/Fox/Fox.glb",
+        "valid/CustomNormals/10_custom_normals.gltf",
+        "valid/Suzanne/monkey.glb",
+        "valid/DegenerateTriangle/index_buffer_degenerate_triangle.gltf",
+    ];
+    let dir = corpus::temp_dir();
+    for asset in assets {
+        let input = corpus.join(asset);
+        for scheme in [Scheme::G2, Scheme::Pn] {
+            let mut written = Vec::new();
+            for report_figures in [false, true] {
+                let mut o = options(1);
+                o.scheme = scheme;
+                o.report_figures = report_figures;
+                let output = dir.path().join(format!("out-{report_figures}.glb"));
+                process_file(&input, &output, &o).unwrap();
+                written.push(std::fs::read(&output).unwrap());
+            }
+            assert!(written[0] == written[1], "{asset}, scheme {scheme}");
+        }
+    }
+}

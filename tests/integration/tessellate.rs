@@ -245,3 +245,67 @@ fn the_surface_can_be_freed_before_the_triangles_are_written() {
         }
     }
 }
+
+/// Every output value of `dense` as bits, so that `-0.0` and `0.0` differ.
+fn bits(dense: &DenseMesh) -> (Vec<[u32; 3]>, Vec<[u32; 3]>, &[VertexSource], &[u32]) {
+    let b = |v: &[[f32; 3]]| v.iter().map(|p| p.map(f32::to_bits)).collect();
+    (
+        b(&dense.positions),
+        b(&dense.normals),
+        &dense.sources,
+        &dense.indices,
+    )
+}
+
+#[test]
+fn level_one_on_the_flat_surface_is_every_schemes_level_one_bit_for_bit() {
+    use g2tess::surface::{build_surface, FlatSurface, Scheme, SchemeParams};
+    // Shared normals, split normals on every edge (a seam everywhere), a cube whose input
+    // normals are not the faces', and signed zeros in the coordinates.
+    let mut signed = icosahedron();
+    for p in &mut signed.positions {
+        *p = p.map(|x| if x.abs() < 1e-12 { -0.0 } else { x });
+    }
+    let meshes = [
+        bumpy_sphere(),
+        split_normals(&bumpy_sphere(), 0.3),
+        cube(),
+        signed,
+    ];
+    for (m, mesh) in meshes.iter().enumerate() {
+        let topo = Topology::build(mesh);
+        // Every third welded edge a crease, where the output is split.
+        let requested: Vec<f64> = (0..topo.edge_count())
+            .map(|e| if e % 3 == 0 { 0.0 } else { 0.2 })
+            .collect();
+        let hs = widths(&topo, &requested);
+        let half = mesh.triangles.len() / 2;
+        let groups = [0..half, half..mesh.triangles.len()];
+        let flat = FlatSurface::new(mesh);
+        let on_flat = tessellate(mesh, &topo, &hs, &flat, 1, &groups);
+        for scheme in Scheme::ALL {
+            let params = SchemeParams::default();
+            let (surface, _) = build_surface(scheme, mesh, &topo, &hs, &params);
+            let on_scheme = tessellate(mesh, &topo, &hs, surface.as_ref(), 1, &groups);
+            for (a, b) in on_flat.iter().zip(&on_scheme) {
+                assert_eq!(bits(a), bits(b), "mesh {m}, scheme {scheme}");
+            }
+            // The corners are the input's: the positions bit for bit, the normals normalized.
+            for (g, dense) in groups.iter().zip(&on_scheme) {
+                for (t, tri) in dense
+                    .indices
+                    .chunks_exact(3)
+                    .zip(&mesh.triangles[g.clone()])
+                {
+                    for (&out, &v) in t.iter().zip(tri) {
+                        let v = v as usize;
+                        let want = mesh.positions[v].as_vec3().to_array().map(f32::to_bits);
+                        assert_eq!(dense.positions[out as usize].map(f32::to_bits), want);
+                        let n = mesh.normals[v].normalize().as_vec3().to_array();
+                        assert_eq!(dense.normals[out as usize], n);
+                    }
+                }
+            }
+        }
+    }
+}
