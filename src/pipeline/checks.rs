@@ -45,7 +45,9 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         let away = tri
             .iter()
             .all(|&v| mesh.normals[v as usize].dot(face) < 0.0);
-        [false, largest_angle_cosine([a, b, c]) > sliver_cos, away]
+        let sliver = !clearly_not_sliver(face, [b - a, c - a, c - b])
+            && largest_angle_cosine([a, b, c]) > sliver_cos;
+        [false, sliver, away]
     });
     if degenerate.count > 0 {
         out.push(Warning::DegenerateTriangles {
@@ -234,6 +236,24 @@ impl Tally {
     }
 }
 
+/// Whether a triangle with cross product `face` of its sides and sides `sides` has no angle
+/// near [`SLIVER_ANGLE`]: a bound that spares nearly every triangle the three square roots and
+/// divisions of [`largest_angle_cosine`], which then decides only the few it leaves.
+///
+/// The smallest angle `α` lies between the two longer sides `b` and `c`, so
+/// `sin α = |face| / (b·c) ≥ |face| / L²` with `L` the longest side. Where
+/// `|face|² ≥ 4 sin²(SLIVER_ANGLE) · L⁴`, `sin α ≥ 2 sin(SLIVER_ANGLE)`, so `α` is more than
+/// twice the sliver angle (`α ≤ 60°`, where the sine rises): a factor no rounding of these few
+/// operations (relative `1e-15`; the squares of `f32` coordinates neither overflow nor
+/// underflow an `f64`) comes near, so the exact test would have said "not a sliver" too and the
+/// count is unchanged.
+#[inline]
+fn clearly_not_sliver(face: DVec3, sides: [DVec3; 3]) -> bool {
+    let longest = sides.iter().map(|s| s.length_squared()).fold(0.0, f64::max);
+    let bound = 2.0 * SLIVER_ANGLE.sin();
+    face.length_squared() >= bound * bound * longest * longest
+}
+
 /// The cosine of the smallest angle of the triangle with corners `p`: comparing cosines instead
 /// of angles spares three arc cosines per triangle, and the order is the same (the cosine falls
 /// as the angle grows).
@@ -398,6 +418,48 @@ mod tests {
     use super::*;
     use crate::topology::tests::odd_mesh;
     use crate::topology::VertId;
+
+    /// The bound never spares a triangle the exact test calls a sliver, and spares every
+    /// triangle whose smallest angle is ten times the sliver angle: needles and flat
+    /// triangles from 1e-5 to 1 radian, at scales from 1e-30 to 1e30, in every corner order.
+    #[test]
+    fn the_sliver_bound_spares_only_triangles_that_are_not_slivers() {
+        let sliver_cos = SLIVER_ANGLE.cos();
+        let (mut spared, mut slivers) = (0, 0);
+        for step in 0..400 {
+            // Smallest angle from 1e-5 to 1 rad, log-spaced, as a needle (apex angle) or a flat
+            // triangle (two small angles at the ends of the long side).
+            let angle = 1e-5 * 10f64.powf(5.0 * f64::from(step) / 399.0);
+            let scale = 10f64.powi(step % 61 - 30);
+            let needle = [
+                DVec3::ZERO,
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(angle.cos(), angle.sin(), 0.0),
+            ];
+            let flat = [
+                DVec3::ZERO,
+                DVec3::new(2.0, 0.0, 0.0),
+                DVec3::new(1.0, angle.tan(), 0.5 * angle.tan()),
+            ];
+            for shape in [needle, flat] {
+                for r in 0..3 {
+                    let p = [0, 1, 2].map(|k| scale * shape[(k + r) % 3] + DVec3::splat(scale));
+                    let [a, b, c] = p;
+                    let face = (b - a).cross(c - a);
+                    let exact = largest_angle_cosine(p) > sliver_cos;
+                    let cleared = clearly_not_sliver(face, [b - a, c - a, c - b]);
+                    assert!(!(exact && cleared), "angle {angle}, scale {scale}");
+                    // On a flat triangle b·c is a quarter of L²: cleared from about 8e-3 rad.
+                    if angle > 10.0 * SLIVER_ANGLE {
+                        assert!(cleared, "angle {angle}, scale {scale}");
+                    }
+                    spared += usize::from(cleared);
+                    slivers += usize::from(exact);
+                }
+            }
+        }
+        assert!(spared > 0 && slivers > 0);
+    }
 
     /// Bow-tie vertices the slow way: per vertex, its distinct triangles joined when they
     /// share an edge through it, components counted by search.
