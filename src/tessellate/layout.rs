@@ -71,7 +71,18 @@ impl GroupLayout {
     ) -> GroupLayout {
         let first = range.start;
         let triangles = &mesh.triangles[range.clone()];
-        let first_half = first_use_of_each_input_edge(mesh, topo, h, range.clone());
+        // Where no edge has a sample (level 1), which half-edge owns an input edge changes no
+        // slot: the edges own nothing, and the pass that finds their first uses (about a
+        // tenth of a level-1 run) is skipped. Their slots are then never read.
+        let sampled = range
+            .clone()
+            .into_par_iter()
+            .any(|tri| (0..3).any(|k| per_edge(tri, k) > 0));
+        let first_half = if sampled {
+            first_use_of_each_input_edge(mesh, topo, h, range.clone())
+        } else {
+            Vec::new()
+        };
         let first_corner = first_use_of_each_vertex(triangles, mesh.positions.len());
         let first_corner_of = |v: u32| first_corner[v as usize].load(Ordering::Relaxed);
         let owns: Vec<u8> = (0..triangles.len())
@@ -84,7 +95,7 @@ impl GroupLayout {
                     }
                 }
                 for k in 0..3 {
-                    if first_half[3 * offset + k] as usize == 3 * offset + k {
+                    if sampled && first_half[3 * offset + k] as usize == 3 * offset + k {
                         owns |= 8 << k;
                     }
                 }
@@ -116,6 +127,9 @@ impl GroupLayout {
                     let (o, c2) = (owner / 3, owner % 3);
                     let rank = (owns[o] & ((1 << c2) - 1)).count_ones();
                     corners[c] = base[o] + rank;
+                }
+                if !sampled {
+                    return;
                 }
                 for (k, slot) in edges.iter_mut().enumerate() {
                     let owner = first_half[3 * offset + k] as usize;
@@ -363,6 +377,29 @@ mod tests {
             triangles: (mesh.triangles.iter().enumerate())
                 .map(|(i, t)| t.map(|v| v + count * (i / per) as u32))
                 .collect(),
+        }
+    }
+
+    /// Without edge samples (level 1) the edges' first uses are not looked for: the corners'
+    /// numbering is still the serial one, and no triangle writes an edge.
+    #[test]
+    fn without_edge_samples_the_corners_are_numbered_as_with_them() {
+        for seed in 0..4 {
+            let mesh = odd_mesh(seed, 20_000 + 1_000 * seed as usize);
+            let mesh = if seed % 2 == 1 { spread(mesh, 6) } else { mesh };
+            let topo = Topology::build(&mesh);
+            let h: Vec<f64> = (0..topo.edge_count())
+                .map(|e| if e % 3 == 0 { 0.0 } else { 0.5 })
+                .collect();
+            let len = mesh.triangles.len();
+            for range in [0..len, 700..len - 300] {
+                let expected = serial(&mesh, &topo, &h, range.clone(), |_, _| 0, |_| 0);
+                let got = GroupLayout::new(&mesh, &topo, &h, 1, 0, range.clone());
+                assert_eq!(got.base, expected.base, "seed {seed}");
+                assert_eq!(got.corner_slot, expected.corner_slot, "seed {seed}");
+                let corners: Vec<u8> = expected.owns.iter().map(|o| o & 7).collect();
+                assert_eq!(got.owns, corners, "seed {seed}");
+            }
         }
     }
 
