@@ -246,8 +246,11 @@ fn the_surface_can_be_freed_before_the_triangles_are_written() {
     }
 }
 
+/// A dense mesh's positions and normals as bits, its sources and its indices.
+type Bits<'a> = (Vec<[u32; 3]>, Vec<[u32; 3]>, &'a [VertexSource], &'a [u32]);
+
 /// Every output value of `dense` as bits, so that `-0.0` and `0.0` differ.
-fn bits(dense: &DenseMesh) -> (Vec<[u32; 3]>, Vec<[u32; 3]>, &[VertexSource], &[u32]) {
+fn bits(dense: &DenseMesh) -> Bits<'_> {
     let b = |v: &[[f32; 3]]| v.iter().map(|p| p.map(f32::to_bits)).collect();
     (
         b(&dense.positions),
