@@ -183,8 +183,8 @@ impl ChordErrors {
     ///    the counts have settled it checks each triangle once, and raises few. A triangle
     ///    whose last check in stage 1 showed that this one would pass too is not checked again
     ///    (with the same counts): its prediction plus what the finer lattice can change of it
-    ///    on a surface smooth at the scale of two lattice steps ([`Curvature::spread`],
-    ///    [`PatternModel::bound`]) is within the tolerance. On the 10k icosphere at the error
+    ///    on a surface smooth at the scale of two lattice steps (`Curvature::spread`,
+    ///    `PatternModel::bound`) is within the tolerance. On the 10k icosphere at the error
     ///    level 16 reaches that is 8,766 of its 9,680 triangles, and the counts are the same
     ///    as with every triangle checked;
     /// 3. measured at the chord module's sample points, on the triangles as written (positions
