@@ -17,8 +17,8 @@ use super::warning::Warning;
 use crate::mesh::TriMesh;
 use crate::topology::{EdgeId, EdgeKind, Topology, TriId};
 
-mod union_find;
-use union_find::UnionFind;
+mod connectivity;
+use connectivity::{bow_tie_vertices, pieces};
 
 /// Triangles whose smallest angle is below this (in radians, about 0.06°) are slivers: valid,
 /// but their normals and parameterization are numerically fragile.
@@ -150,6 +150,9 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
     out
 }
 
+/// Indices one task of [`Tally::of_each`] tests.
+const TALLY_BLOCK: usize = 4096;
+
 /// How many indices passed a test, and the first [`EXAMPLES`] of them, found without listing
 /// them all (a scan of a million bad triangles keeps three).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -162,36 +165,30 @@ impl Tally {
     /// The indices in `0..n` for which `hit` holds, tested in parallel; the examples are the
     /// smallest whatever the thread count (parts are merged in index order).
     fn of(n: usize, hit: impl Fn(usize) -> bool + Sync) -> Tally {
-        (0..n)
-            .into_par_iter()
-            .fold(Tally::default, |mut t, i| {
-                if hit(i) {
-                    t.add(i);
-                }
-                t
-            })
-            .reduce(Tally::default, |mut a, b| {
-                a.merge(&b);
-                a
-            })
+        let [t] = Tally::of_each(n, |i| [hit(i)]);
+        t
     }
 
     /// [`Tally::of`] for `N` tests at once, in one pass: `hit(i)[k]` says whether `i` passes
     /// test `k`.
+    ///
+    /// Each task tallies a block of [`TALLY_BLOCK`] indices in a plain loop and only the
+    /// blocks' tallies are merged (in block order): a fold over single indices moved the
+    /// tallies in and out of the folding closure once per index.
     fn of_each<const N: usize>(n: usize, hit: impl Fn(usize) -> [bool; N] + Sync) -> [Tally; N] {
-        (0..n)
+        (0..n.div_ceil(TALLY_BLOCK))
             .into_par_iter()
-            .fold(
-                || [Tally::default(); N],
-                |mut t, i| {
+            .map(|b| {
+                let mut t = [Tally::default(); N];
+                for i in b * TALLY_BLOCK..((b + 1) * TALLY_BLOCK).min(n) {
                     for (k, passed) in hit(i).into_iter().enumerate() {
                         if passed {
                             t[k].add(i);
                         }
                     }
-                    t
-                },
-            )
+                }
+                t
+            })
             .reduce(
                 || [Tally::default(); N],
                 |mut a, b| {
@@ -339,78 +336,6 @@ fn same_direction(topo: &Topology, e: usize) -> bool {
     let (t, k) = topo.edge_uses(EdgeId(e as u32))[0].at();
     topo.neighbour(TriId(t as u32), k)
         .is_some_and(|n| n.slots[0] == (n.slots[2] + 1) % 3)
-}
-
-/// Welded vertices whose triangles form more than one fan (connected through edges that contain
-/// the vertex).
-///
-/// One union-find over the triangle corners (`3 × triangle + corner`, a triangle with two
-/// welded corners at one vertex counting once, by its first): every edge joins the corners of
-/// all its triangles at each of its end points, straight from its uses. Walking edges rather than
-/// triangles keeps this linear in the corners whatever the valence (a book of 100 000 triangles
-/// on one edge, or 100 000 copies of one triangle), where joining per triangle and edge use was
-/// cubic in it. The edges are joined in parallel ([`UnionFind`]). A vertex is a bow-tie when its
-/// corners fall into two or more classes.
-fn bow_tie_vertices(topo: &Topology) -> Tally {
-    // The corner of `t` holding the welded vertex of its corner `c`: the first with it.
-    let canonical = |t: usize, c: usize| {
-        let v = topo.tri_verts[t];
-        let first = v.iter().position(|&x| x == v[c]).unwrap_or(c);
-        (3 * t + first) as u32
-    };
-    let corners = UnionFind::new(3 * topo.tri_verts.len() as u32);
-    (0..topo.edge_count()).into_par_iter().for_each(|e| {
-        let uses = topo.edge_uses(EdgeId(e as u32));
-        let Some((&head, rest)) = uses.split_first() else {
-            return;
-        };
-        let (t0, k0) = head.at();
-        for end in [1, 2] {
-            let anchor = canonical(t0, (k0 + end) % 3);
-            for u in rest {
-                let (t, k) = u.at();
-                // The use's corner at the same welded vertex as the anchor.
-                let c = if topo.tri_verts[t][(k + end) % 3] == topo.tri_verts[t0][(k0 + end) % 3] {
-                    (k + end) % 3
-                } else {
-                    (k + 3 - end) % 3
-                };
-                corners.union(anchor, canonical(t, c));
-            }
-        }
-    });
-    // A vertex is a bow-tie when two of its canonical corners are roots (the smallest corner of
-    // each class): the first root marks the vertex seen, any later one marks it a bow-tie.
-    let blank = || -> Vec<AtomicBool> {
-        (0..topo.welded_positions.len())
-            .map(|_| AtomicBool::new(false))
-            .collect()
-    };
-    let (seen, bow_tie) = (blank(), blank());
-    (0..topo.tri_verts.len()).into_par_iter().for_each(|t| {
-        for c in 0..3 {
-            let corner = (3 * t + c) as u32;
-            if canonical(t, c) == corner && corners.is_root(corner) {
-                let v = topo.tri_verts[t][c].0 as usize;
-                if seen[v].swap(true, Relaxed) {
-                    bow_tie[v].store(true, Relaxed);
-                }
-            }
-        }
-    });
-    Tally::of(bow_tie.len(), |v| bow_tie[v].load(Relaxed))
-}
-
-/// Connected pieces of triangles (through welded edges), joined in parallel.
-fn pieces(topo: &Topology) -> usize {
-    let n = topo.tri_verts.len() as u32;
-    let tris = UnionFind::new(n);
-    (0..topo.edge_count()).into_par_iter().for_each(|e| {
-        for w in topo.edge_uses(EdgeId(e as u32)).windows(2) {
-            tris.union(w[0].tri().0, w[1].tri().0);
-        }
-    });
-    (0..n).into_par_iter().filter(|&i| tris.is_root(i)).count()
 }
 
 #[cfg(test)]
@@ -590,6 +515,167 @@ mod tests {
                 assert_eq!(pieces_got, pieces_want, "seed {seed}, {threads} threads");
             }
         }
+    }
+
+    /// A named shape for the fan walk: triangles over vertex ids, and whether every edge is
+    /// interior or boundary (so the walk alone decides every vertex).
+    type Shape = (&'static str, Vec<[u32; 3]>, bool);
+
+    /// Shapes whose bow-ties and pieces differ in how their fans close: closed fans meeting at
+    /// one vertex, open fans split in three, isolated triangles, mixed winding, pinched tori
+    /// (more vertices than one block of the walk), copies of a triangle, and, to leave to the
+    /// corners, a book of pages beside a fan and triangles with a repeated corner. Corners are
+    /// rotated per triangle so the vertex sits in every slot.
+    fn fan_shapes() -> Vec<Shape> {
+        let rotate = |tris: Vec<[u32; 3]>| -> Vec<[u32; 3]> {
+            tris.into_iter()
+                .enumerate()
+                .map(|(i, t)| [t[i % 3], t[(i + 1) % 3], t[(i + 2) % 3]])
+                .collect()
+        };
+        let tet = |a: u32, b: u32, c: u32, d: u32| [[a, b, c], [a, d, b], [a, c, d], [b, d, c]];
+        let mut two_tets = tet(0, 1, 2, 3).to_vec();
+        two_tets.extend(tet(0, 4, 5, 6));
+        let closed_fan: Vec<[u32; 3]> = (1..=6).map(|i| [0, i, i % 6 + 1]).collect();
+        let mut mixed = closed_fan.clone();
+        mixed[2] = [mixed[2][0], mixed[2][2], mixed[2][1]];
+        mixed[4] = [mixed[4][0], mixed[4][2], mixed[4][1]];
+        // Two closed fans at vertex 0 (a double cone), interleaved in triangle order.
+        let cone = |ring: [u32; 4]| -> Vec<[u32; 3]> {
+            (0..4).map(|i| [0, ring[i], ring[(i + 1) % 4]]).collect()
+        };
+        let (a, b) = (cone([1, 2, 3, 4]), cone([5, 6, 7, 8]));
+        let double_cone = a.iter().zip(&b).flat_map(|(x, y)| [*x, *y]).collect();
+        let torus = |m: u32, n: u32, base: u32, pinch: u32| -> Vec<[u32; 3]> {
+            let at = |i: u32, j: u32| {
+                let k = (i % m) * n + (j % n);
+                if k == 0 {
+                    pinch
+                } else {
+                    base + k
+                }
+            };
+            (0..m)
+                .flat_map(|i| (0..n).map(move |j| (i, j)))
+                .flat_map(|(i, j)| {
+                    [
+                        [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                        [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+                    ]
+                })
+                .collect()
+        };
+        let mut pinched = torus(50, 45, 0, 0);
+        pinched.extend(torus(40, 30, 50 * 45, 0));
+        let mut book: Vec<[u32; 3]> = (2..7).map(|k| [0, 1, k]).collect();
+        book.extend([[0, 7, 8], [0, 8, 9], [10, 11, 12]]);
+        vec![
+            ("two tetrahedra on one vertex", rotate(two_tets), true),
+            ("double cone", rotate(double_cone), true),
+            (
+                "fan split in three",
+                rotate(vec![
+                    [0, 4, 5],
+                    [0, 1, 2],
+                    [0, 8, 9],
+                    [0, 2, 3],
+                    [0, 5, 6],
+                    [0, 7, 8],
+                ]),
+                true,
+            ),
+            ("closed fan", rotate(closed_fan), true),
+            ("mixed winding", rotate(mixed), true),
+            (
+                "isolated triangles",
+                vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]],
+                true,
+            ),
+            ("pinched tori", rotate(pinched), true),
+            ("two copies", vec![[0, 1, 2], [1, 2, 0], [0, 3, 4]], true),
+            (
+                "three copies",
+                vec![[0, 1, 2], [1, 2, 0], [2, 1, 0], [0, 3, 4]],
+                false,
+            ),
+            ("book beside a fan", rotate(book), false),
+            (
+                "repeated corners",
+                vec![
+                    [0, 0, 1],
+                    [0, 1, 2],
+                    [0, 2, 3],
+                    [0, 4, 5],
+                    [4, 4, 4],
+                    [5, 6, 6],
+                ],
+                false,
+            ),
+        ]
+    }
+
+    /// The mesh of a shape, each vertex on the moment curve (no three collinear, so only a
+    /// repeated corner makes a triangle degenerate).
+    fn shape_mesh(tris: &[[u32; 3]]) -> TriMesh {
+        let n = tris.iter().flatten().max().map_or(0, |&v| v + 1);
+        let positions: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let t = f64::from(i) / f64::from(n);
+                DVec3::new(t, t * t, t * t * t)
+            })
+            .collect();
+        TriMesh {
+            normals: vec![DVec3::Z; positions.len()],
+            positions,
+            triangles: tris.to_vec(),
+        }
+    }
+
+    #[test]
+    fn fan_walks_match_the_slow_definitions_on_fans_of_every_kind() {
+        let mut all: Vec<[u32; 3]> = Vec::new();
+        let mut shapes = fan_shapes();
+        for (_, tris, _) in &shapes {
+            let base = all.iter().flatten().max().map_or(0, |&v| v + 1);
+            all.extend(tris.iter().map(|t| t.map(|v| v + base)));
+        }
+        shapes.push(("all at once", all, false));
+        for (name, tris, clean) in &shapes {
+            let topo = Topology::build(&shape_mesh(tris));
+            if *clean {
+                assert_eq!(
+                    connectivity::undecided(&topo),
+                    Vec::<usize>::new(),
+                    "{name}"
+                );
+            }
+            let want = bow_ties_by_search(&topo);
+            let pieces_want = pieces_by_search(&topo);
+            for threads in [1, 2] {
+                let (got, pieces_got) = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| (bow_tie_vertices(&topo), pieces(&topo)));
+                assert_eq!(got.count, want.len(), "{name}, {threads} threads");
+                assert_eq!(got.examples(), &want[..want.len().min(EXAMPLES)], "{name}");
+                assert_eq!(pieces_got, pieces_want, "{name}, {threads} threads");
+            }
+        }
+        // Each kind of fan was met: bow-ties through closed and open fans alike.
+        let count = |name: &str| {
+            let (_, tris, _) = shapes.iter().find(|s| s.0 == name).unwrap();
+            bow_ties_by_search(&Topology::build(&shape_mesh(tris))).len()
+        };
+        for name in [
+            "two tetrahedra on one vertex",
+            "double cone",
+            "fan split in three",
+        ] {
+            assert_eq!(count(name), 1, "{name}");
+        }
+        assert_eq!(count("pinched tori"), 1);
+        assert_eq!(count("closed fan") + count("mixed winding"), 0);
     }
 
     #[test]
