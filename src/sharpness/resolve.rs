@@ -3,6 +3,7 @@
 
 use std::collections::HashMap;
 
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::entries::{at, fmt_point, Block, EdgeEntry, Located};
@@ -10,8 +11,9 @@ use super::error::{Location, Problem, SharpnessError};
 use super::explain::HSource;
 use super::extras::{parse_block, Owner};
 use super::naming::EdgeNamer;
-use super::rules::{is_hard_edge, CreaseTest};
+use super::rules::{face_normals, is_hard_edge, CreaseTest};
 use super::{mesh_label, AssetSharpness, EdgeParams, EffectiveH, MeshContext, SharpnessWarning};
+
 use crate::mesh::TriMesh;
 use crate::topology::{Edge, EdgeId, EdgeKind, Topology};
 
@@ -115,6 +117,8 @@ pub(crate) fn resolve(
         None => primitive_of_triangle(ctx, mesh),
     };
 
+    // Each triangle's face normal once, for the crease rule on its three edges.
+    let faces = face_normals(topo);
     // Edges are independent: resolved in parallel, collected in edge order.
     let pick = |(e, edge): &(usize, Edge<'_>)| {
         let id = EdgeId(*e as u32);
@@ -139,7 +143,7 @@ pub(crate) fn resolve(
             })
             .map_or((default_test, None), |p| (side_test(p), side_crease(p))),
         };
-        if let Some(rule) = crease_rule(edge, topo, crease_side) {
+        if let Some(rule) = crease_rule(edge, topo, &faces, crease_side) {
             return rule;
         }
         if asset.defaults.keep_hard_edges && is_hard_edge(edge) {
@@ -212,10 +216,11 @@ fn sharpest(sides: impl Iterator<Item = u32>, value: impl Fn(u32) -> f64) -> Opt
 fn crease_rule<'a>(
     edge: &Edge<'_>,
     topo: &Topology,
+    faces: &[DVec3],
     side: (CreaseTest, Option<&'a Located<f64>>),
 ) -> Option<Pick<'a>> {
     let (test, set_by) = side;
-    let dihedral = test.dihedral_if_crease(edge, topo)?;
+    let dihedral = test.dihedral_if_crease(edge, topo, faces)?;
     Some(Pick::Crease {
         dihedral,
         crease_angle: test.crease_angle(),

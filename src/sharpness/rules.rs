@@ -2,8 +2,9 @@
 //! and hard edges (split normals) in the input. It deliberately does not decide precedence.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
-use crate::topology::{Edge, EdgeKind, Topology};
+use crate::topology::{Edge, EdgeKind, Topology, TriId};
 
 /// The dihedral angle must exceed the crease angle by more than this to count as a crease, so an
 /// edge built at exactly the threshold (60° from `cos`/`sin` coordinates) is not flipped by
@@ -58,8 +59,22 @@ impl CreaseTest {
     /// from any crease: an edge whose angle's cosine lies clearly above the threshold's (by
     /// 1e-9, a million times the rounding of either side) is decided without it. Every other
     /// edge, including all near the threshold, takes the exact path, so the result is the same.
-    pub fn dihedral_if_crease(&self, edge: &Edge<'_>, topo: &Topology) -> Option<f64> {
-        let (n0, n1) = oriented_normals(edge, topo)?;
+    ///
+    /// The face normals are read from `faces` ([`face_normals`]): each triangle's is computed
+    /// once rather than once per edge, and an edge reads two of them instead of two triangles'
+    /// corners and six positions. They are the normals [`dihedral_degrees`] computes, bit for
+    /// bit, so the result is the same.
+    pub fn dihedral_if_crease(
+        &self,
+        edge: &Edge<'_>,
+        topo: &Topology,
+        faces: &[DVec3],
+    ) -> Option<f64> {
+        self.decide(oriented_faces(edge, topo, faces)?)
+    }
+
+    /// The rule on an interior edge's oriented face normals.
+    fn decide(&self, (n0, n1): (DVec3, DVec3)) -> Option<f64> {
         // cos / radius > clear, compared in squares: no square root or division per edge,
         // and rounding far inside the 1e-9 margin.
         let (cos, clear) = (n0.dot(n1), self.clear_cosine);
@@ -98,6 +113,33 @@ fn oriented_normals(edge: &Edge<'_>, topo: &Topology) -> Option<(DVec3, DVec3)> 
         n1 = -n1;
     }
     Some((n0, n1))
+}
+
+/// Every triangle's face normal as [`oriented_normals`] computes it (the cross product of two
+/// sides from the welded positions, not normalized), in parallel: read by the crease rule for
+/// each of a triangle's three edges instead of computed three times.
+pub fn face_normals(topo: &Topology) -> Vec<DVec3> {
+    topo.tri_verts
+        .par_iter()
+        .map(|v| {
+            let [a, b, c] = v.map(|v| topo.welded_positions[v.0 as usize]);
+            (b - a).cross(c - a)
+        })
+        .collect()
+}
+
+/// [`oriented_normals`] read from `faces`: the second flipped where the neighbour across the
+/// edge runs along it in the same direction (it holds the first triangle's corner `k + 1` in
+/// its slot `r + 1`, the start of its own edge), which is where the corners' test flips it.
+fn oriented_faces(edge: &Edge<'_>, topo: &Topology, faces: &[DVec3]) -> Option<(DVec3, DVec3)> {
+    if edge.kind != EdgeKind::Interior {
+        return None;
+    }
+    let (t0, k0) = edge.tris.first()?.at();
+    let n = topo.neighbour(TriId(t0 as u32), k0)?;
+    let n1 = faces[n.tri.0 as usize];
+    let same_way = n.slots[0] == (n.slots[2] + 1) % 3;
+    Some((faces[t0], if same_way { -n1 } else { n1 }))
 }
 
 /// Whether an edge of this dihedral angle is a crease under `crease_angle`.
@@ -141,6 +183,56 @@ mod tests {
         }
     }
 
+    /// The face normals read from the array are the ones computed from the corners, bit for
+    /// bit, with the same flips: odd shapes with mixed winding, books, copies and signed zeros.
+    #[test]
+    fn normals_from_the_face_array_are_the_computed_ones() {
+        // A torus with every third triangle wound the other way and signed zeros on its
+        // equator (mostly interior edges), and odd shapes (mostly not).
+        let (m, n) = (24u32, 16u32);
+        let at = |i: u32, j: u32| (i % m) * n + (j % n);
+        let mut torus = TriMesh::default();
+        for i in 0..m {
+            for j in 0..n {
+                let (u, v) = (
+                    f64::from(i) * std::f64::consts::TAU / f64::from(m),
+                    f64::from(j) * std::f64::consts::TAU / f64::from(n),
+                );
+                let z = if j == 0 { -0.0 } else { v.sin() };
+                let r = 2.0 + v.cos();
+                torus
+                    .positions
+                    .push(DVec3::new(r * u.cos(), r * u.sin(), z));
+                for t in [
+                    [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                    [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+                ] {
+                    let flip = torus.triangles.len() % 3 == 0;
+                    torus
+                        .triangles
+                        .push(if flip { [t[0], t[2], t[1]] } else { t });
+                }
+            }
+        }
+        torus.normals = vec![DVec3::Z; torus.positions.len()];
+        let odd =
+            (0..30).map(|seed| crate::topology::tests::odd_mesh(seed, 20 + 9 * seed as usize));
+        let mut interior = 0;
+        for mesh in std::iter::once(torus).chain(odd) {
+            let topo = Topology::build(&mesh);
+            let faces = face_normals(&topo);
+            for edge in topo.edges() {
+                let bits = |n: Option<(DVec3, DVec3)>| {
+                    n.map(|(a, b)| [a, b].map(|v| v.to_array().map(f64::to_bits)))
+                };
+                let want = oriented_normals(&edge, &topo);
+                assert_eq!(bits(oriented_faces(&edge, &topo, &faces)), bits(want));
+                interior += usize::from(want.is_some());
+            }
+        }
+        assert!(interior > 1000, "{interior}");
+    }
+
     /// The shortcut decides every edge as the exact rule does: folds from flat to nearly
     /// folded back, crease angles at, just below and just above each fold (down to the slack),
     /// at tiny, unit and huge scales (where the squares under- or overflow and the exact path
@@ -153,6 +245,7 @@ mod tests {
                 let fold = f64::from(i) * 0.999;
                 let mesh = hinge(fold, scale);
                 let topo = Topology::build(&mesh);
+                let faces = face_normals(&topo);
                 let edge = topo
                     .edges()
                     .find(|e| e.kind == EdgeKind::Interior)
@@ -172,7 +265,7 @@ mod tests {
                 ] {
                     let expected = is_crease(exact, angle).then_some(exact);
                     assert_eq!(
-                        CreaseTest::new(angle).dihedral_if_crease(&edge, &topo),
+                        CreaseTest::new(angle).dihedral_if_crease(&edge, &topo, &faces),
                         expected,
                         "fold {fold}, scale {scale}, crease angle {angle}"
                     );
