@@ -48,8 +48,12 @@ pub(super) fn bow_tie_vertices(topo: &Topology) -> Tally {
         .map(|b| {
             let mut tally = Tally::default();
             let mut undecided = Vec::new();
-            for v in b * BLOCK..((b + 1) * BLOCK).min(around.len()) {
-                let a = around[v];
+            let start = b * BLOCK;
+            for (i, &a) in around[start..(start + BLOCK).min(around.len())]
+                .iter()
+                .enumerate()
+            {
+                let v = start + i;
                 // No triangle, or one: one fan at most.
                 if a.triangles < 2 {
                     continue;
