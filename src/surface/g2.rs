@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::neighbour_net::{compose_across, Reach, SoaNet};
 use super::nets::Nets;
-use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights, LANES};
+use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, LANES};
 use super::pn::{Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
@@ -224,15 +224,24 @@ impl<'a> G2Surface<'a> {
             .topo
             .neighbour(TriId(tri as u32), k)
             .expect("blended edges are interior");
-        let g = self.local(n.tri.0 as usize).net;
-        compose_across(&g, k, n.slots.map(usize::from), reach)
+        let [p, q, r] = n.slots.map(usize::from);
+        // An edge's composition never reads the neighbour's points next to its third corner
+        // `r` (exponent 2 of `μ_r`, see `compose_across`): they are not put back into their
+        // tangent plane.
+        let unread = match reach {
+            Reach::Whole => 0,
+            Reach::Edge => (1 << (NEAR[r][p] - 3)) | (1 << (NEAR[r][q] - 3)),
+        };
+        let g = n.tri.0 as usize;
+        let g = local(self.mesh, g, &self.patches[g], unread).net;
+        compose_across(&g, k, [p, q, r], reach)
     }
 
     /// Triangle `tri`'s whole net and corner normals, exactly as they were when its net was
     /// stored.
     #[inline]
     fn local(&self, tri: usize) -> Local {
-        local(self.mesh, tri, &self.patches[tri])
+        local(self.mesh, tri, &self.patches[tri], 0)
     }
 
     /// The profile `r(s)` in use.
@@ -248,16 +257,24 @@ impl<'a> G2Surface<'a> {
     /// derivatives); the normal is `∂_u S × ∂_v S`, oriented by the interpolated input normals.
     /// Each lane's sums run in the same order whatever `L`, so a lattice block and a single
     /// point agree bit for bit.
+    ///
+    /// Only the control points `rows` are summed (in slot order): [`ALL_ROWS`], or, where the
+    /// pattern found every other weight exactly zero, [`EDGE_ROWS`]`[k]`. Leaving such a term
+    /// out leaves every bit as it was: the sums start at `+0` and so are never `−0` (in
+    /// round-to-nearest `a + b = −0` only when both are `−0`), the nets are finite (finite
+    /// `f32` positions, unit normals, bounded handles), so each left-out term `±0·x` is `±0`,
+    /// and adding `±0` to a sum that is not `−0` does not change it.
     #[inline(always)]
-    fn combine<const L: usize>(
+    fn combine<const L: usize, const R: usize>(
         normal: &[DVec3; 3],
         w: &Lanes<L>,
         own: &Broadcast<L>,
         across: Option<&Broadcast<L>>,
+        rows: &[usize; R],
     ) -> [SurfacePoint; L] {
-        let mut acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3]);
+        let mut acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], rows);
         if let Some(across) = across {
-            acc = accumulate(&w.across, across, acc);
+            acc = accumulate(&w.across, across, acc, rows);
         }
         std::array::from_fn(|l| {
             let v = |q: usize| DVec3::new(acc[q][0][l], acc[q][1][l], acc[q][2][l]);
@@ -284,6 +301,9 @@ impl<'a> G2Surface<'a> {
     }
 }
 
+/// Every control point, in slot order: the rows [`G2Surface::combine`] sums by default.
+const ALL_ROWS: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9];
+
 /// A control net with every coordinate repeated in `L` lanes, `[control point][x, y, z][lane]`:
 /// the sums of [`accumulate`] are then the same operation on whole lanes, which compilers turn
 /// into SIMD arithmetic without being told.
@@ -306,13 +326,13 @@ fn broadcast<const L: usize>(net: &SoaNet) -> Broadcast<L> {
 /// The sums are taken and returned by value, and written as plain indexed loops: kept out of
 /// memory that way, the compiler unrolls them and runs the lanes in SIMD registers.
 #[inline(always)]
-fn accumulate<const L: usize>(
+fn accumulate<const L: usize, const R: usize>(
     w: &NetWeights<L>,
     net: &Broadcast<L>,
     mut acc: [[[f64; L]; 3]; 3],
+    rows: &[usize; R],
 ) -> [[[f64; L]; 3]; 3] {
-    #[allow(clippy::needless_range_loop)]
-    for m in 0..10 {
+    for &m in rows {
         for q in 0..3 {
             for c in 0..3 {
                 for l in 0..L {
@@ -341,20 +361,27 @@ fn corner(net: &SoaNet, c: usize) -> DVec3 {
 /// Normalized here, each time, rather than once per vertex into an array of their own: the
 /// division costs less than the memory, and it is the same arithmetic on every path, so a
 /// net is rebuilt bit for bit.
+///
+/// Written as plain loops rather than `array::map`: every patch set-up and every lattice part
+/// comes through here, and the closures `map` takes were not inlined.
 #[inline]
 fn corners(mesh: &TriMesh, verts: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
-    let position = verts.map(|v| mesh.positions[v as usize]);
-    // Only for the rare vertex without a normal: every patch set-up and every lattice part
-    // comes through here.
-    let mut face = None;
-    let normal = verts.map(|v| {
-        let n = mesh.normals[v as usize].normalize_or(DVec3::ZERO);
-        if n == DVec3::ZERO {
-            *face.get_or_insert_with(|| face_fallback(position))
-        } else {
-            n
+    let mut position = [DVec3::ZERO; 3];
+    let mut normal = [DVec3::ZERO; 3];
+    for c in 0..3 {
+        let v = verts[c] as usize;
+        position[c] = mesh.positions[v];
+        normal[c] = mesh.normals[v].normalize_or(DVec3::ZERO);
+    }
+    // Only for the rare vertex without a normal.
+    if normal.contains(&DVec3::ZERO) {
+        let face = face_fallback(position);
+        for n in &mut normal {
+            if *n == DVec3::ZERO {
+                *n = face;
+            }
         }
-    });
+    }
     (position, normal)
 }
 
@@ -366,25 +393,28 @@ fn face_fallback(p: [DVec3; 3]) -> DVec3 {
 }
 
 /// Triangle `tri`'s whole net and corner normals from its `patch` (see [`G2Surface::local`]).
+///
+/// The edge points in the bit set `unread` (bit `m − 3` for slot `m`) are left as stored, not
+/// put back into their tangent plane: for a caller that never reads them.
 #[inline]
-fn local(mesh: &TriMesh, tri: usize, patch: &Patch) -> Local {
+fn local(mesh: &TriMesh, tri: usize, patch: &Patch, unread: u8) -> Local {
     let (position, normal) = corners(mesh, mesh.triangles[tri]);
-    let mut net = std::array::from_fn(|x| {
+    // Plain loops, not `array::from_fn`, whose closure was not inlined (see `corners`).
+    let mut net = [[0.0; 10]; 3];
+    for (x, coord) in net.iter_mut().enumerate() {
         let p = coordinate(&position, x);
-        let mut coord = [0.0; 10];
         coord[..3].copy_from_slice(&p);
         for (m, (point, &offset)) in coord[3..].iter_mut().zip(&patch.inner[x]).enumerate() {
             *point = flat_point(p, 3 + m) + f64::from(offset);
         }
-        coord
-    });
-    onto_tangent_planes(&mut net, &normal, patch.as_stored);
+    }
+    onto_tangent_planes(&mut net, &normal, patch.as_stored | unread);
     Local { net, normal }
 }
 
 /// Edge control point `slot` of triangle `tri`'s `patch`, as [`local`] rebuilds it.
 fn edge_point(mesh: &TriMesh, tri: usize, patch: &Patch, slot: usize) -> DVec3 {
-    let net = local(mesh, tri, patch).net;
+    let net = local(mesh, tri, patch, 0).net;
     DVec3::new(net[0][slot], net[1][slot], net[2][slot])
 }
 
@@ -457,7 +487,13 @@ impl PointEvaluation {
             &*self.across[k]
                 .get_or_insert_with(|| broadcast(&surface.across_net(tri, k, Reach::Whole)))
         });
-        let [p] = G2Surface::combine(&self.local.normal, &Lanes::<1>::single(&w), &self.own, net);
+        let [p] = G2Surface::combine(
+            &self.local.normal,
+            &Lanes::<1>::single(&w),
+            &self.own,
+            net,
+            &ALL_ROWS,
+        );
         p
     }
 }
@@ -590,7 +626,18 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                         &cached.as_ref().expect("composed just above").1
                     });
                     for lanes in blocks {
-                        let points = G2Surface::combine(&local.normal, lanes, own, across);
+                        let points = match pattern.edge_rows {
+                            Some(k) => G2Surface::combine(
+                                &local.normal,
+                                lanes,
+                                own,
+                                across,
+                                &EDGE_ROWS[k as usize],
+                            ),
+                            None => {
+                                G2Surface::combine(&local.normal, lanes, own, across, &ALL_ROWS)
+                            }
+                        };
                         for (&target, p) in lanes.target.iter().zip(points) {
                             if target != Lanes::<1>::PADDING {
                                 out[target as usize] = p;
@@ -708,7 +755,7 @@ fn share_unblended_edge_curves(
     touched.dedup();
     for t in touched {
         let t = t as usize;
-        let Local { net, normal } = local(mesh, t, &patches[t]);
+        let Local { net, normal } = local(mesh, t, &patches[t], 0);
         let centre = rule.centre(&aos(&net), normal);
         set_point(mesh, t, &mut patches[t], B111, centre);
     }

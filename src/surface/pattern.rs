@@ -30,7 +30,7 @@ use std::sync::Arc;
 
 use super::blend::BlendWeight;
 use super::lattice_cache::{Entry, LatticeCache};
-use super::pn::Bernstein;
+use super::pn::{Bernstein, IJK};
 use super::profile::Profile;
 use super::{lattice_bary, LatticePart};
 
@@ -153,7 +153,33 @@ pub struct Pattern {
     pub plain: Vec<Lanes<LANES>>,
     /// `blended[k]`: points that blend with the neighbour across the edge opposite corner `k`.
     pub blended: [Vec<Lanes<LANES>>; 3],
+    /// `Some(k)`: every weight of every block, on both nets, is exactly zero (`±0`) on the
+    /// three control points whose exponent of `λ_k` is 2 or 3, so the sums need only the other
+    /// seven ([`EDGE_ROWS`]`[k]`). So it is for every part on edge `k` (`λ_k = 0`: those
+    /// points' Bernstein values and derivatives all have a factor `λ_k`); it is found by
+    /// looking at the weights, never assumed, and `None` wherever one of them is not zero.
+    pub edge_rows: Option<u8>,
 }
+
+/// `EDGE_ROWS[k]`: the control points whose exponent of `λ_k` is 0 or 1, in slot order: all
+/// that a point on edge `k` weighs (see [`Pattern::edge_rows`]).
+pub const EDGE_ROWS: [[usize; 7]; 3] = {
+    let mut rows = [[0; 7]; 3];
+    let mut k = 0;
+    while k < 3 {
+        let (mut m, mut n) = (0, 0);
+        while m < 10 {
+            if IJK[m][k] <= 1 {
+                rows[k][n] = m;
+                n += 1;
+            }
+            m += 1;
+        }
+        assert!(n == 7);
+        k += 1;
+    }
+    rows
+};
 
 impl Pattern {
     /// Computes the pattern of `part` of the level-`n` lattice (`n ≥ 1`).
@@ -163,6 +189,7 @@ impl Pattern {
             corners: Vec::new(),
             plain: Vec::new(),
             blended: [Vec::new(), Vec::new(), Vec::new()],
+            edge_rows: None,
         };
         // Lanes filled so far in the last block of each group.
         let mut filled = [LANES; 4];
@@ -188,6 +215,19 @@ impl Pattern {
             filled[group] += 1;
         }
         pattern.len = points.len();
+        if let LatticePart::Edge(k) = part {
+            let zero_off_row = |w: &NetWeights<LANES>| {
+                w.iter().all(|quantity| {
+                    (0..10)
+                        .filter(|&m| IJK[m][k as usize] >= 2)
+                        .all(|m| quantity[m].iter().all(|&x| x == 0.0))
+                })
+            };
+            let mut blocks = pattern.plain.iter().chain(pattern.blended.iter().flatten());
+            if blocks.all(|lanes| zero_off_row(&lanes.own) && zero_off_row(&lanes.across)) {
+                pattern.edge_rows = Some(k);
+            }
+        }
         pattern
     }
 }
@@ -240,5 +280,35 @@ impl PatternCache {
         self.0
             .get_or_build(key, build)
             .unwrap_or_else(|| Entry::Shared(Arc::new(build())))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What the edge parts' shortcut rests on, found in the weights themselves: every edge part
+    /// of every level, width and profile drops exactly the three control points off its rows
+    /// (so the fast sums are the ones taken at level 2, where every evaluated point is an
+    /// edge's), and no part with interior points drops any.
+    #[test]
+    fn edge_parts_and_only_edge_parts_leave_out_the_points_off_their_rows() {
+        for profile in [Profile::Paper, Profile::C2] {
+            for h in [[0.212; 3], [0.05, 0.3, 0.35], [0.35, 0.0, 0.1], [0.0; 3]] {
+                for n in 2..=12 {
+                    for k in 0..3u8 {
+                        let edge = Pattern::new(n, LatticePart::Edge(k), h, profile);
+                        assert_eq!(edge.edge_rows, Some(k), "{n} {k} {h:?}");
+                    }
+                    for part in [LatticePart::All, LatticePart::Interior] {
+                        assert_eq!(Pattern::new(n, part, h, profile).edge_rows, None);
+                    }
+                }
+            }
+        }
+        for (k, rows) in EDGE_ROWS.iter().enumerate() {
+            assert!(rows.windows(2).all(|w| w[0] < w[1]), "slot order");
+            assert!(rows.iter().all(|&m| IJK[m][k] <= 1));
+        }
     }
 }

@@ -214,19 +214,22 @@ fn first_use_of_each_input_edge(
     let start = range.start;
     // What makes two uses of a welded edge the same input edge: the input vertex pair, and on
     // a crease the half-edge itself (each side its own). `None` outside the group.
-    let key = |tri: usize, k: usize| -> Option<InputEdge> {
+    // `crease`: whether the welded edge is a crease, the same for all its uses, so it is
+    // decided once per half-edge, not once per use compared.
+    let key_on = |crease: bool, tri: usize, k: usize| -> Option<InputEdge> {
         if !range.contains(&tri) {
             return None;
         }
         let t = mesh.triangles[tri];
         let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
-        let side = if is_crease(topo, h, topo.tri_edges[tri][k]) {
+        let side = if crease {
             (3 * (tri - start) + k) as u32
         } else {
             u32::MAX
         };
         Some((a.min(b), a.max(b), side))
     };
+    let key = |tri: usize, k: usize| key_on(is_crease(topo, h, topo.tri_edges[tri][k]), tri, k);
     let half_of = |tri: usize, k: usize| (3 * (tri - start) + k) as u32;
     // Books: per welded edge with many uses, its group uses sorted by (key, half-edge).
     let mut books: Vec<(u32, Vec<(InputEdge, u32)>)> = (0..topo.edge_count())
@@ -251,7 +254,8 @@ fn first_use_of_each_input_edge(
         .map(|half| {
             let (tri, k) = (start + half / 3, half % 3);
             let e = topo.tri_edges[tri][k];
-            let own = key(tri, k).expect("in the group");
+            let crease = is_crease(topo, h, e);
+            let own = key_on(crease, tri, k).expect("in the group");
             let uses = topo.edge_uses(e);
             if uses.len() > FEW_USES {
                 let book = &books[books.binary_search_by_key(&e.0, |b| b.0).expect("a book")].1;
@@ -261,7 +265,7 @@ fn first_use_of_each_input_edge(
             uses.iter()
                 .find_map(|u| {
                     let (t, c) = u.at();
-                    (key(t, c) == Some(own)).then(|| half_of(t, c))
+                    (key_on(crease, t, c) == Some(own)).then(|| half_of(t, c))
                 })
                 .expect("a half-edge is a use of its own welded edge")
         })

@@ -4,7 +4,9 @@
 
 use crate::support::*;
 use g2tess::sharpness::EffectiveH;
-use g2tess::surface::{lattice_bary, G2Surface, Nets, PnSurface, Profile, Surface, H_MAX};
+use g2tess::surface::{
+    lattice_bary, G2Surface, LatticePart, Nets, PnSurface, Profile, Surface, H_MAX,
+};
 use g2tess::topology::Topology;
 use glam::DVec3;
 
@@ -212,5 +214,49 @@ fn h_is_clamped_and_unblendable_edges_are_reported() {
     for t in 0..mesh.triangles.len() {
         let p = s.evaluate(t, [0.2, 0.3, 0.5]);
         assert!(p.position.is_finite() && (p.normal.length() - 1.0).abs() < 1e-12);
+    }
+}
+
+/// Edge parts sum only the seven control points of their edge's rows, on both nets, and
+/// rebuild only the neighbour points an edge's composition reads: each edge part, alone and
+/// with the others, must still equal `evaluate` at its points (which sums all ten of every
+/// net and composes the whole neighbour net) bit for bit, on split normals (edge points kept
+/// as stored) and with some edges at h = 0 (plain points on an edge), in every corner order.
+#[test]
+fn edge_parts_equal_point_evaluation_bit_for_bit() {
+    let mut rng = Lcg(29);
+    for mesh in [
+        bumpy_sphere(),
+        reorder(&split_normals(&bumpy_sphere(), 0.5), 0.4, 7).mesh,
+    ] {
+        let topo = Topology::build(&mesh);
+        let h: Vec<f64> = topo
+            .edges()
+            .map(|_| (rng.next() * 4.0).floor() * 0.1)
+            .collect();
+        let h_s = widths(&topo, &h);
+        for profile in [Profile::C2, Profile::Paper] {
+            let s = G2Surface::new(&mesh, &topo, &h_s, profile);
+            for level in [2, 3, 6] {
+                for t in 0..mesh.triangles.len() {
+                    let parts: Vec<_> = (0..3).map(|k| (level, LatticePart::Edge(k))).collect();
+                    let mut together = Vec::new();
+                    s.evaluate_lattice_parts(t, &parts, &mut together);
+                    let mut want = Vec::new();
+                    for &(_, part) in &parts {
+                        let mut alone = Vec::new();
+                        s.evaluate_lattice_part(t, level, part, &mut alone);
+                        let points: Vec<_> = part
+                            .points(level)
+                            .iter()
+                            .map(|&(i, j)| s.evaluate(t, lattice_bary(level, i, j)))
+                            .collect();
+                        assert_eq!(alone, points, "triangle {t} level {level} {part:?}");
+                        want.extend(points);
+                    }
+                    assert_eq!(together, want, "triangle {t} level {level}");
+                }
+            }
+        }
     }
 }
