@@ -70,6 +70,9 @@ impl Curvature {
     /// Appends what [`Curvature::restore`] takes back: the second differences read, in
     /// interior lattice order, then the spread.
     pub fn keep(&self, into: &mut Vec<[f64; 3]>) {
+        // Held per triangle until its next check: exactly as large as it needs to be, not
+        // doubled by the spread's push.
+        into.reserve_exact(self.at.len() + 1);
         into.extend_from_slice(&self.at);
         into.push([self.spread, 0.0, 0.0]);
     }

@@ -7,12 +7,15 @@
 
 use crate::support::*;
 use g2tess::mesh::TriMesh;
-use g2tess::surface::{G2Surface, Profile};
+use g2tess::surface::{G2Surface, LatticePart, Profile, Surface, SurfacePoint};
 use g2tess::tessellate::{
     chord_error, tessellate, tessellate_with_counts, ChordErrors, DenseMesh, SegmentCounts,
+    PROBE_LEVEL,
 };
 use g2tess::topology::Topology;
 use glam::DVec3;
+use std::collections::HashMap;
+use std::sync::Mutex;
 
 struct Run {
     topo: Topology,
@@ -400,4 +403,83 @@ fn a_budget_leaves_a_flat_mesh_at_one_segment_per_edge() {
     let (_, counts) = ChordErrors::probe(&dome, &topo, &surface).for_budget(&topo, 20_000, 64);
     let written = counts.triangle_count(&topo);
     assert!(written > 10_000 && written <= 20_000, "{written}");
+}
+
+/// A surface that counts its whole-lattice evaluations by (triangle, level).
+struct CountingLattices<'a> {
+    inner: &'a dyn Surface,
+    lattices: Mutex<HashMap<(usize, u32), u32>>,
+}
+
+impl Surface for CountingLattices<'_> {
+    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
+        self.inner.evaluate(tri, bary)
+    }
+
+    fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
+        *self
+            .lattices
+            .lock()
+            .unwrap()
+            .entry((tri, level))
+            .or_insert(0) += 1;
+        self.inner.evaluate_lattice(tri, level, out);
+    }
+
+    fn evaluate_lattice_part(
+        &self,
+        tri: usize,
+        level: u32,
+        part: LatticePart,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        self.inner.evaluate_lattice_part(tri, level, part, out);
+    }
+
+    fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
+        self.inner.evaluate_points(tri, barys, out);
+    }
+}
+
+#[test]
+fn no_lattice_finer_than_the_probe_is_evaluated_twice() {
+    // On an evenly curved mesh the counts settle in a wave: a failing triangle raises an edge,
+    // and its neighbour, which passed, is checked again with only that edge changed. The
+    // lattice of a triangle and level is the same whenever it is evaluated, so what a check
+    // read from it is kept until the triangle is checked again, passing or failing, and no
+    // lattice above the probe's level (where a flat part's checks keep nothing) is evaluated
+    // twice. The 5,120-triangle icosphere at the errors of levels 8 and 16 (1.8e-5, 4.5e-6).
+    let mesh = icosphere(4);
+    let topo = Topology::build(&mesh);
+    let hs = h_all(&topo, 0.2);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let errors = ChordErrors::probe(&mesh, &topo, &surface);
+    let mut rechecked = 0;
+    for tolerance in [1.8e-5, 4.5e-6] {
+        let counting = CountingLattices {
+            inner: &surface,
+            lattices: Mutex::new(HashMap::new()),
+        };
+        let counts = errors.refine_to_tolerance(&topo, &counting, tolerance, 64);
+        let lattices = counting.lattices.into_inner().unwrap();
+        let twice: Vec<_> = lattices
+            .iter()
+            .filter(|&(&(_, level), &n)| level > PROBE_LEVEL && n > 1)
+            .collect();
+        let above = lattices.keys().filter(|&&(_, l)| l > PROBE_LEVEL).count();
+        println!(
+            "{tolerance:e}: {above} lattices above the probe's level, largest count {}",
+            counts.max()
+        );
+        rechecked += above.saturating_sub(mesh.triangles.len());
+        assert!(
+            twice.is_empty(),
+            "{tolerance:e}: {} of {above} lattices evaluated more than once, e.g. {:?}",
+            twice.len(),
+            twice.first()
+        );
+    }
+    // Not vacuous: triangles were checked at several levels above the probe's (the counts
+    // moved after their first check there).
+    assert!(rechecked > 0, "no triangle was checked twice");
 }
