@@ -97,6 +97,16 @@ pub struct Neighbour {
     pub slots: [u8; 3],
 }
 
+impl Neighbour {
+    /// Whether g runs along the shared edge in the same direction as f (one of the two is wound
+    /// the other way): f's edge runs from its corner i to j, g's from its slot `r + 1` to
+    /// `r + 2`, so both run the same way exactly when g holds i in slot `r + 1`. Read from the
+    /// slots alone, without either triangle's corners.
+    pub fn runs_same_way(&self) -> bool {
+        self.slots[0] == (self.slots[2] + 1) % 3
+    }
+}
+
 /// A [`Neighbour`] in one `u32`: `2 × (3g + r) + swapped`, where `r` is g's corner opposite the
 /// shared edge and `swapped` says f's corner `i` sits in g's slot `r + 2` rather than `r + 1`;
 /// [`NO_NEIGHBOUR`] for edges that are not interior. A third of the `Option<Neighbour>` it

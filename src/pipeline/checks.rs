@@ -327,15 +327,12 @@ fn duplicate_triangles(topo: &Topology) -> Tally {
 }
 
 /// Do both triangles of interior edge `e` run along it in the same direction (one of them is
-/// wound the other way)?
-///
-/// Read from the first triangle's neighbour: its edge runs from its corner i to its corner j,
-/// and the neighbour's edge from its slot `r + 1` to `r + 2`, so both run the same way exactly
-/// when the neighbour holds i in slot `r + 1` (no triangle lookup needed).
+/// wound the other way)? Read from the first triangle's neighbour's slots
+/// ([`Neighbour::runs_same_way`](crate::topology::Neighbour::runs_same_way)).
 fn same_direction(topo: &Topology, e: usize) -> bool {
     let (t, k) = topo.edge_uses(EdgeId(e as u32))[0].at();
     topo.neighbour(TriId(t as u32), k)
-        .is_some_and(|n| n.slots[0] == (n.slots[2] + 1) % 3)
+        .is_some_and(|n| n.runs_same_way())
 }
 
 #[cfg(test)]

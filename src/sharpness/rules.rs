@@ -129,8 +129,9 @@ pub fn face_normals(topo: &Topology) -> Vec<DVec3> {
 }
 
 /// [`oriented_normals`] read from `faces`: the second flipped where the neighbour across the
-/// edge runs along it in the same direction (it holds the first triangle's corner `k + 1` in
-/// its slot `r + 1`, the start of its own edge), which is where the corners' test flips it.
+/// edge runs along it in the same direction
+/// ([`Neighbour::runs_same_way`](crate::topology::Neighbour::runs_same_way)), which is where
+/// the corners' test flips it.
 fn oriented_faces(edge: &Edge<'_>, topo: &Topology, faces: &[DVec3]) -> Option<(DVec3, DVec3)> {
     if edge.kind != EdgeKind::Interior {
         return None;
@@ -138,8 +139,7 @@ fn oriented_faces(edge: &Edge<'_>, topo: &Topology, faces: &[DVec3]) -> Option<(
     let (t0, k0) = edge.tris.first()?.at();
     let n = topo.neighbour(TriId(t0 as u32), k0)?;
     let n1 = faces[n.tri.0 as usize];
-    let same_way = n.slots[0] == (n.slots[2] + 1) % 3;
-    Some((faces[t0], if same_way { -n1 } else { n1 }))
+    Some((faces[t0], if n.runs_same_way() { -n1 } else { n1 }))
 }
 
 /// Whether an edge of this dihedral angle is a crease under `crease_angle`.
