@@ -9,6 +9,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::neighbour_net::{compose_across, Reach, SoaNet};
+use super::net_memo::{self, Local};
 use super::nets::Nets;
 use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, LANES};
 use super::pn::{Net, B111, NEAR};
@@ -108,12 +109,6 @@ fn offsets(net: &Net) -> [[f32; INNER]; 3] {
     out
 }
 
-/// One triangle's whole net and corner normals, put together for a lattice part or a point.
-struct Local {
-    net: SoaNet,
-    normal: [DVec3; 3],
-}
-
 /// The G² blended surface of Lee–Hwang–Yoon over a whole mesh, one width `h` per welded edge.
 ///
 /// It borrows the mesh (corner positions and normals), its topology (each triangle's edges, and
@@ -128,6 +123,8 @@ pub struct G2Surface<'a> {
     patches: Vec<Patch>,
     profile: Profile,
     patterns: PatternCache,
+    /// This surface's tag in the per-thread memo of rebuilt nets ([`net_memo`]).
+    memo_owner: u64,
 }
 
 impl<'a> G2Surface<'a> {
@@ -185,6 +182,7 @@ impl<'a> G2Surface<'a> {
             patches,
             profile,
             patterns: PatternCache::default(),
+            memo_owner: net_memo::new_owner(),
         };
         debug_assert!((0..mesh.triangles.len()).all(|t| (0..3)
             .all(|k| surface.widths(t)[k] == 0.0 || topo.neighbour(TriId(t as u32), k).is_some())));
@@ -225,23 +223,24 @@ impl<'a> G2Surface<'a> {
             .neighbour(TriId(tri as u32), k)
             .expect("blended edges are interior");
         let [p, q, r] = n.slots.map(usize::from);
-        // An edge's composition never reads the neighbour's points next to its third corner
-        // `r` (exponent 2 of `μ_r`, see `compose_across`): they are not put back into their
-        // tangent plane.
-        let unread = match reach {
-            Reach::Whole => 0,
-            Reach::Edge => (1 << (NEAR[r][p] - 3)) | (1 << (NEAR[r][q] - 3)),
-        };
-        let g = n.tri.0 as usize;
-        let g = local(self.mesh, g, &self.patches[g], unread).net;
-        compose_across(&g, k, [p, q, r], reach)
+        // The neighbour's whole net, as its own lattice parts read it: usually kept from its
+        // first rebuild (`net_memo`). An edge's composition never reads the two points next to
+        // the neighbour's third corner `r` (exponent 2 of `μ_r`, see `compose_across`), and
+        // every other point is rebuilt by the same arithmetic whether those two are put back
+        // into their tangent plane or not (each point's projection reads only itself, its
+        // corner and that corner's normal), so the composed net has the same bits either way.
+        self.with_local(n.tri.0 as usize, |g| {
+            compose_across(&g.net, k, [p, q, r], reach)
+        })
     }
 
-    /// Triangle `tri`'s whole net and corner normals, exactly as they were when its net was
-    /// stored.
+    /// `read` of triangle `tri`'s whole net and corner normals, exactly as they were when its
+    /// net was stored: kept in this thread's memo from an earlier rebuild when there is one,
+    /// which has the same bits (`net_memo`).
     #[inline]
-    fn local(&self, tri: usize) -> Local {
-        local(self.mesh, tri, &self.patches[tri], 0)
+    fn with_local<R>(&self, tri: usize, read: impl FnOnce(&Local) -> R) -> R {
+        let rebuild = |out: &mut Local| local_into(self.mesh, tri, &self.patches[tri], out);
+        net_memo::with_local(self.memo_owner, tri, rebuild, read)
     }
 
     /// The profile `r(s)` in use.
@@ -392,15 +391,23 @@ fn face_fallback(p: [DVec3; 3]) -> DVec3 {
     (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(DVec3::Z)
 }
 
-/// Triangle `tri`'s whole net and corner normals from its `patch` (see [`G2Surface::local`]).
-///
-/// The edge points in the bit set `unread` (bit `m − 3` for slot `m`) are left as stored, not
-/// put back into their tangent plane: for a caller that never reads them.
+/// Triangle `tri`'s whole net and corner normals from its `patch` (see
+/// [`G2Surface::with_local`]).
+fn local(mesh: &TriMesh, tri: usize, patch: &Patch) -> Local {
+    let mut out = Local {
+        net: [[0.0; 10]; 3],
+        normal: [DVec3::ZERO; 3],
+    };
+    local_into(mesh, tri, patch, &mut out);
+    out
+}
+
+/// [`local`], written into `out` (a slot of the memo of rebuilt nets, without a copy).
 #[inline]
-fn local(mesh: &TriMesh, tri: usize, patch: &Patch, unread: u8) -> Local {
+fn local_into(mesh: &TriMesh, tri: usize, patch: &Patch, out: &mut Local) {
     let (position, normal) = corners(mesh, mesh.triangles[tri]);
     // Plain loops, not `array::from_fn`, whose closure was not inlined (see `corners`).
-    let mut net = [[0.0; 10]; 3];
+    let net = &mut out.net;
     for (x, coord) in net.iter_mut().enumerate() {
         let p = coordinate(&position, x);
         coord[..3].copy_from_slice(&p);
@@ -408,13 +415,13 @@ fn local(mesh: &TriMesh, tri: usize, patch: &Patch, unread: u8) -> Local {
             *point = flat_point(p, 3 + m) + f64::from(offset);
         }
     }
-    onto_tangent_planes(&mut net, &normal, patch.as_stored | unread);
-    Local { net, normal }
+    onto_tangent_planes(net, &normal, patch.as_stored);
+    out.normal = normal;
 }
 
 /// Edge control point `slot` of triangle `tri`'s `patch`, as [`local`] rebuilds it.
 fn edge_point(mesh: &TriMesh, tri: usize, patch: &Patch, slot: usize) -> DVec3 {
-    let net = local(mesh, tri, patch, 0).net;
+    let net = local(mesh, tri, patch).net;
     DVec3::new(net[0][slot], net[1][slot], net[2][slot])
 }
 
@@ -462,11 +469,11 @@ struct PointEvaluation {
 
 impl PointEvaluation {
     fn new(surface: &G2Surface, tri: usize) -> Self {
-        let local = surface.local(tri);
+        let (local, own) = surface.with_local(tri, |local| (*local, broadcast(&local.net)));
         PointEvaluation {
             tri,
             widths: surface.widths(tri),
-            own: broadcast(&local.net),
+            own,
             local,
             across: [None; 3],
         }
@@ -559,12 +566,12 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
     /// The set-up for the lattice parts `parts` of triangle `tri`.
     #[inline]
     fn new(surface: &'s G2Surface<'a>, tri: usize, parts: &[(u32, LatticePart)]) -> Self {
-        let local = surface.local(tri);
+        let (local, own) = surface.with_local(tri, |local| (*local, broadcast(&local.net)));
         PartEvaluation {
             surface,
             tri,
             widths: surface.widths(tri),
-            own: broadcast(&local.net),
+            own,
             local,
             across: [None; 3],
             edges_only: parts
@@ -755,7 +762,7 @@ fn share_unblended_edge_curves(
     touched.dedup();
     for t in touched {
         let t = t as usize;
-        let Local { net, normal } = local(mesh, t, &patches[t], 0);
+        let Local { net, normal } = local(mesh, t, &patches[t]);
         let centre = rule.centre(&aos(&net), normal);
         set_point(mesh, t, &mut patches[t], B111, centre);
     }

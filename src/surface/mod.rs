@@ -33,7 +33,9 @@
 //! [`lattice_cache`], as the other schemes' lattice weights are), and
 //! `g2.rs` ([`G2Surface`], [`PnSurface`]: nets per triangle, combination, normals), with
 //! `neighbour_net.rs` (the neighbour's net in the triangle's own barycentrics, Eq. 3, computed
-//! as `pn::compose` computes it but with only the arithmetic that can change a bit).
+//! as `pn::compose` computes it but with only the arithmetic that can change a bit) and
+//! `net_memo.rs` (each thread's last rebuilt nets, so that a triangle's net is rebuilt about
+//! once for its own parts and its neighbours' edges together).
 
 pub mod blend;
 pub mod coons;
@@ -42,6 +44,7 @@ mod g2;
 pub mod hybrid;
 pub mod lattice_cache;
 mod neighbour_net;
+mod net_memo;
 pub mod nets;
 pub mod pattern;
 pub mod pn;

@@ -271,6 +271,40 @@ mod tests {
         }
     }
 
+    /// What lets the G² surface hand an edge's composition a net whose two points next to the
+    /// neighbour's third corner were rebuilt differently (it reads one rebuilt net for every
+    /// use): [`Reach::Edge`] never reads those two points, whatever they hold.
+    #[test]
+    fn an_edge_composition_reads_nothing_next_to_the_neighbours_third_corner() {
+        use crate::surface::pn::NEAR;
+        for net in nets() {
+            for k in 0..3 {
+                for slots in [
+                    [0, 1, 2],
+                    [1, 2, 0],
+                    [2, 0, 1],
+                    [0, 2, 1],
+                    [2, 1, 0],
+                    [1, 0, 2],
+                ] {
+                    let r = slots[2];
+                    let mut moved = by_coordinate(&net);
+                    for coord in &mut moved {
+                        coord[NEAR[r][slots[0]]] = 1e300;
+                        coord[NEAR[r][slots[1]]] = f64::NAN;
+                    }
+                    let want = compose_across(&by_coordinate(&net), k, slots, Reach::Edge);
+                    let got = compose_across(&moved, k, slots, Reach::Edge);
+                    for x in 0..3 {
+                        for m in 0..10 {
+                            assert_eq!(got[x][m].to_bits(), want[x][m].to_bits(), "{k} {m}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// What [`Reach::Edge`] rests on: on an edge part every neighbour weight of a control point
     /// with exponent 2 or 3 of the edge's `λ_k` is exactly zero.
     #[test]
