@@ -40,6 +40,9 @@ pub(crate) struct Curvature {
     /// reads (scaled to this lattice's step) can lie from [`Curvature::at`]: see
     /// [`Curvature::spread`].
     spread: f64,
+    /// The inner lattice error last computed on this lattice and the inner level it was for
+    /// ([`Curvature::inner_error`]); level 0: none.
+    inner: (u32, f64),
 }
 
 /// The largest of `|½ Σ_{a<b} w_a w_b|` over the sample weights: the most a unit change of
@@ -68,13 +71,13 @@ fn interior_index(n: u32, i: u32, j: u32) -> usize {
 
 impl Curvature {
     /// Appends what [`Curvature::restore`] takes back: the second differences read, in
-    /// interior lattice order, then the spread.
+    /// interior lattice order, then the spread and the last inner lattice error with its level.
     pub fn keep(&self, into: &mut Vec<[f64; 3]>) {
         // Held per triangle until its next check: exactly as large as it needs to be, not
-        // doubled by the spread's push.
+        // doubled by the trailer's push.
         into.reserve_exact(self.at.len() + 1);
         into.extend_from_slice(&self.at);
-        into.push([self.spread, 0.0, 0.0]);
+        into.push([self.spread, f64::from(self.inner.0), self.inner.1]);
     }
 
     /// Takes back what [`Curvature::keep`] appended for a level-`level` lattice read before,
@@ -89,7 +92,9 @@ impl Curvature {
         self.level = level;
         self.at.clear();
         self.at.extend_from_slice(&values[..interior]);
-        self.spread = values[interior][0];
+        let [spread, inner_level, inner_error] = values[interior];
+        self.spread = spread;
+        self.inner = (inner_level as u32, inner_error);
         true
     }
 
@@ -118,17 +123,24 @@ impl Curvature {
     pub fn read(&mut self, points: &[SurfacePoint], level: u32) {
         debug_assert!(level >= 3);
         self.level = level;
+        self.inner = (0, 0.0);
         self.at.clear();
-        let at = |i: u32, j: u32| points[lattice_index(level, i, j)].position;
+        // Row by row (the rows below, at and above the points read), the same sums as
+        // `at(i ± 1, j)`, `at(i, j ± 1)` and `at(i ± 1, j ∓ 1)` in the same order.
         for j in 1..level {
-            for i in 1..level - j {
-                let p = &points[lattice_index(level, i, j)];
+            let (below, here, above) = (
+                row(points, level, j - 1),
+                row(points, level, j),
+                row(points, level, j + 1),
+            );
+            for i in 1..(level - j) as usize {
+                let p = &here[i];
                 let centre = 2.0 * p.position;
                 let along = |d: DVec3| d.dot(p.normal);
                 self.at.push([
-                    along(at(i - 1, j) - centre + at(i + 1, j)),
-                    along(at(i, j - 1) - centre + at(i, j + 1)),
-                    along(at(i + 1, j - 1) - centre + at(i - 1, j + 1)),
+                    along(here[i - 1].position - centre + here[i + 1].position),
+                    along(below[i].position - centre + above[i].position),
+                    along(below[i + 1].position - centre + above[i - 1].position),
                 ]);
             }
         }
@@ -147,31 +159,40 @@ impl Curvature {
         if level < 6 {
             return f64::INFINITY;
         }
-        let at = |i: u32, j: u32| points[lattice_index(level, i, j)].position;
         let mut richardson = 0.0f64;
         let mut change = 0.0f64;
         let mut index = 0;
         for j in 1..level {
+            // Points two rows below and above, where they exist (`i + j + 2 ≤ level` below).
+            let here = row(points, level, j);
+            let (below, above) = if j >= 2 && j + 2 <= level {
+                (row(points, level, j - 2), row(points, level, j + 2))
+            } else {
+                (here, here)
+            };
+            // Interior points of row `j` (`i` from 1): the next row's start, `(i, j + 1)`.
+            let row_length = (level - 1 - j) as usize;
             for i in 1..level - j {
                 let fine = self.at[index];
                 if i >= 2 && j >= 2 && i + j + 2 <= level {
-                    let p = &points[lattice_index(level, i, j)];
+                    let i = i as usize;
+                    let p = &here[i];
                     let centre = 2.0 * p.position;
                     let along = |d: DVec3| 0.25 * d.dot(p.normal);
                     let coarse = [
-                        along(at(i - 2, j) - centre + at(i + 2, j)),
-                        along(at(i, j - 2) - centre + at(i, j + 2)),
-                        along(at(i + 2, j - 2) - centre + at(i - 2, j + 2)),
+                        along(here[i - 2].position - centre + here[i + 2].position),
+                        along(below[i].position - centre + above[i].position),
+                        along(below[i + 2].position - centre + above[i - 2].position),
                     ];
                     for k in 0..3 {
-                        richardson = richardson.max((coarse[k] - fine[k]).abs());
+                        richardson = larger(richardson, (coarse[k] - fine[k]).abs());
                     }
                 }
                 // The neighbours (i + 1, j) and (i, j + 1), when interior.
                 if i + j + 1 < level {
-                    for other in [self.at[index + 1], self.at[interior_index(level, i, j + 1)]] {
+                    for other in [self.at[index + 1], self.at[index + row_length]] {
                         for k in 0..3 {
-                            change = change.max((other[k] - fine[k]).abs());
+                            change = larger(change, (other[k] - fine[k]).abs());
                         }
                     }
                 }
@@ -183,6 +204,17 @@ impl Curvature {
         } else {
             f64::INFINITY
         }
+    }
+
+    /// [`Curvature::lattice_error`] of a level-`m` inner lattice (`m ≥ 1`), computed once per
+    /// lattice and level: a triangle checked again with only its edge counts raised (most of
+    /// the checks while the counts settle, restored by [`Curvature::restore`]) has the same
+    /// inner lattice error, bit for bit, and the model's boundary part is all that changes.
+    pub fn inner_error(&mut self, m: u32) -> f64 {
+        if self.inner.0 != m {
+            self.inner = (m, self.lattice_error(m));
+        }
+        self.inner.1
     }
 
     /// The largest predicted error of the inner lattice of a level-`m` pattern (every triangle
@@ -207,7 +239,7 @@ impl Curvature {
                     let q = self.at[index];
                     // A point whose bound is under the largest error so far cannot change it.
                     if bound(q) > worst {
-                        worst = worst.max(worst_abs(q));
+                        worst = larger(worst, worst_abs(q));
                     }
                 }
                 index += 1;
@@ -236,15 +268,63 @@ impl Curvature {
     }
 }
 
-/// An upper bound of [`worst_abs`]`(q)`, by [`WEIGHT_GAIN`], with room for its rounding.
+/// The larger of a running maximum `max`, never NaN, and `x`; `max` when `x` is NaN, as
+/// `f64::max` gives, in one comparison (the maxima of the checks' loops, run per lattice point
+/// and per model sample).
+#[inline]
+fn larger(max: f64, x: f64) -> f64 {
+    if x > max {
+        x
+    } else {
+        max
+    }
+}
+
+/// Row `j` of a level-`level` lattice in lattice order: points `(0, j)` to `(level − j, j)`.
+#[inline]
+fn row(points: &[SurfacePoint], level: u32, j: u32) -> &[SurfacePoint] {
+    let start = lattice_index(level, 0, j);
+    &points[start..start + (level + 1 - j) as usize]
+}
+
+/// An upper bound of [`worst_abs`]`(q)`, with room for its rounding: each sample's error is at
+/// most `½ Σ_{a<b} w_a w_b |Q_ab|`, which is `|Q_ab|/8` at an edge midpoint and at most
+/// `Σ|Q|/18` at the centroid and at the points halfway to the corners (their products `w_a w_b`
+/// are `1/9`, `1/9`, `1/36`, each at most the centroid's `1/9`). It is at most
+/// `WEIGHT_GAIN · max |Q|` and tighter where the three differ, so fewer points whose error
+/// cannot change a maximum have [`worst_abs`] computed.
 #[inline]
 fn bound(q: [f64; 3]) -> f64 {
-    WEIGHT_GAIN * BOUND_SLACK * q[0].abs().max(q[1].abs()).max(q[2].abs())
+    let [a, b, c] = q.map(f64::abs);
+    BOUND_SLACK * (0.125 * a.max(b).max(c)).max((a + b + c) * (1.0 / 18.0))
 }
 
 /// The largest error over the sample weights for `q = [Q_01, Q_12, Q_02]` (normal components).
 #[inline]
 fn worst_abs(q: [f64; 3]) -> f64 {
+    if !(q[0].is_finite() && q[1].is_finite() && q[2].is_finite()) {
+        return worst_abs_any(q);
+    }
+    let sample = |w: [f64; 3]| 0.5 * (w[0] * w[1] * q[0] + w[1] * w[2] * q[1] + w[0] * w[2] * q[2]);
+    // At an edge midpoint two of the three products are 0 and add a signed zero, which
+    // changes neither the sum nor its absolute value for finite `q`: left out.
+    let [_, m01, m12, m02, ..] = WEIGHTS;
+    let midpoints = [
+        0.5 * (m01[0] * m01[1] * q[0]),
+        0.5 * (m12[1] * m12[2] * q[1]),
+        0.5 * (m02[0] * m02[2] * q[2]),
+    ];
+    [WEIGHTS[0], WEIGHTS[4], WEIGHTS[5], WEIGHTS[6]]
+        .map(sample)
+        .into_iter()
+        .chain(midpoints)
+        .map(f64::abs)
+        .fold(0.0, larger)
+}
+
+/// [`worst_abs`] term by term over every sample weight, for any `q` (a non-finite one makes
+/// some terms NaN, which the maximum skips).
+fn worst_abs_any(q: [f64; 3]) -> f64 {
     WEIGHTS
         .iter()
         .map(|w| (0.5 * (w[0] * w[1] * q[0] + w[1] * w[2] * q[1] + w[0] * w[2] * q[2])).abs())
@@ -378,9 +458,9 @@ impl PatternModel {
 
     /// The predicted errors of this pattern over the surface whose second differences are
     /// `curvature` (a lattice of level at least the pattern's inner level).
-    pub fn error(&self, curvature: &Curvature) -> PatternError {
+    pub fn error(&self, curvature: &mut Curvature) -> PatternError {
         let mut out = PatternError {
-            inner: curvature.lattice_error(self.key.inner),
+            inner: curvature.inner_error(self.key.inner),
             edges: [0.0; 3],
         };
         debug_assert_eq!(
@@ -389,14 +469,18 @@ impl PatternModel {
         );
         for t in &self.boundary {
             // The smallest maximum this sample could raise.
-            let floor = (0..3)
-                .filter(|k| t.touches & (1 << k) != 0)
-                .map(|k| out.edges[k])
-                .fold(f64::INFINITY, f64::min);
+            let touched = |k: usize| {
+                if t.touches & (1 << k) != 0 {
+                    out.edges[k]
+                } else {
+                    f64::INFINITY
+                }
+            };
+            let floor = touched(0).min(touched(1)).min(touched(2));
             let e = curvature.sample_error(t, floor);
             for (k, edge) in out.edges.iter_mut().enumerate() {
                 if t.touches & (1 << k) != 0 {
-                    *edge = edge.max(e);
+                    *edge = larger(*edge, e);
                 }
             }
         }
@@ -495,13 +579,13 @@ mod tests {
             for key in keys() {
                 let pattern = Pattern::new(key);
                 let (coarse_level, fine_level) = (key.inner.max(6), 2 * key.inner);
-                let coarse = curvature(&height_lattice(coarse_level, 1.0, &f), coarse_level);
-                let fine = curvature(&height_lattice(fine_level, 1.0, &f), fine_level);
+                let mut coarse = curvature(&height_lattice(coarse_level, 1.0, &f), coarse_level);
+                let mut fine = curvature(&height_lattice(fine_level, 1.0, &f), fine_level);
                 let coarse_model = PatternModel::new(&pattern, coarse_level);
                 let fine_model = PatternModel::new(&pattern, fine_level);
-                let predicted = coarse_model.error(&coarse);
+                let predicted = coarse_model.error(&mut coarse);
                 let bound = coarse_model.bound(&predicted, coarse.spread());
-                let finer = fine_model.error(&fine);
+                let finer = fine_model.error(&mut fine);
                 assert!(coarse.spread().is_finite());
                 assert!(
                     finer.inner <= bound.inner,
@@ -554,8 +638,8 @@ mod tests {
             for key in keys() {
                 let pattern = Pattern::new(key);
                 for level in [key.inner.max(6), 2 * key.inner] {
-                    let c = curvature(&height_lattice(level, 1.0, &f), level);
-                    let error = PatternModel::new(&pattern, level).error(&c);
+                    let mut c = curvature(&height_lattice(level, 1.0, &f), level);
+                    let error = PatternModel::new(&pattern, level).error(&mut c);
                     let l2 = f64::from(level).powi(2);
                     let mut plain = PatternError::default();
                     let (l, m) = (level, key.inner);
@@ -604,5 +688,88 @@ mod tests {
                 }
             }
         }
+    }
+    /// `q` spread over magnitudes and signs, from a fixed-seed generator, with the cases
+    /// where two or all three are equal or zero.
+    fn sample_qs() -> Vec<[f64; 3]> {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let unit = (state >> 11) as f64 / (1u64 << 53) as f64;
+            (2.0 * unit - 1.0) * 10f64.powi((state % 13) as i32 - 9)
+        };
+        let mut qs: Vec<[f64; 3]> = (0..20_000).map(|_| [next(), next(), next()]).collect();
+        qs.extend([
+            [1.0, 1.0, 1.0],
+            [-1.0, 1.0, -1.0],
+            [1.0, 0.0, 0.0],
+            [0.0, -2.5e-6, 0.0],
+            [0.0, 0.0, 0.0],
+            [-0.0, 0.0, -0.0],
+            [3e-7, 3e-7, -1e-7],
+        ]);
+        qs
+    }
+
+    /// The sample-by-sample maximum without its zero terms is the term-by-term one, bit for
+    /// bit, so the predictions (and the counts) are those of the plain formula.
+    #[test]
+    fn the_worst_sample_is_the_term_by_term_maximum() {
+        for q in sample_qs() {
+            assert_eq!(worst_abs(q).to_bits(), worst_abs_any(q).to_bits(), "{q:?}");
+        }
+        for q in [
+            [f64::INFINITY, 1.0, 0.0],
+            [f64::NAN, 1.0, 2.0],
+            [1.0, f64::NEG_INFINITY, 1.0],
+        ] {
+            let (a, b) = (worst_abs(q), worst_abs_any(q));
+            assert!(a.to_bits() == b.to_bits(), "{q:?}: {a} against {b}");
+        }
+    }
+
+    /// The filter's bound is at or above every sample's error (else a maximum could be missed)
+    /// and below the plain `max |Q| / 6` where the three differ (else it filters nothing more).
+    #[test]
+    fn the_bound_holds_and_is_tighter_where_the_differences_differ() {
+        let mut tighter = 0;
+        for q in sample_qs() {
+            let b = bound(q);
+            assert!(b >= worst_abs(q), "{q:?}: {b} under {}", worst_abs(q));
+            let plain = WEIGHT_GAIN * BOUND_SLACK * q[0].abs().max(q[1].abs()).max(q[2].abs());
+            assert!(b <= plain, "{q:?}: {b} over {plain}");
+            if b < 0.9 * plain {
+                tighter += 1;
+            }
+        }
+        assert!(tighter > 10_000, "tighter on {tighter} of 20,007");
+    }
+
+    /// A restored lattice gives back the inner lattice error it kept for the same inner level
+    /// and computes it afresh for another level or another lattice, each bit for bit
+    /// [`Curvature::lattice_error`].
+    #[test]
+    fn the_kept_inner_error_is_the_lattice_error_of_its_level_only() {
+        let fields = smooth_fields();
+        let level = 12;
+        let mut c = curvature(&height_lattice(level, 1.0, &fields[0]), level);
+        let first = c.inner_error(9);
+        assert_eq!(first.to_bits(), c.lattice_error(9).to_bits());
+        let mut kept = Vec::new();
+        c.keep(&mut kept);
+        let mut restored = Curvature::default();
+        assert!(restored.restore(level, &kept));
+        assert_eq!(restored.inner_error(9).to_bits(), first.to_bits());
+        let other = restored.inner_error(6);
+        assert_eq!(other.to_bits(), c.lattice_error(6).to_bits());
+        assert_ne!(other.to_bits(), first.to_bits(), "levels 6 and 9 differ");
+        // Another lattice read into the same storage forgets the kept value.
+        let points = height_lattice(level, 1.0, &fields[1]);
+        restored.read(&points, level);
+        let fresh = curvature(&points, level).lattice_error(9);
+        assert_ne!(fresh.to_bits(), first.to_bits(), "the fields differ");
+        assert_eq!(restored.inner_error(9).to_bits(), fresh.to_bits());
     }
 }
