@@ -16,6 +16,9 @@ use glam::DVec3;
 
 use crate::mesh::TriMesh;
 
+mod weld;
+use weld::weld;
+
 /// A welded vertex (one per distinct position).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct VertId(pub u32);
@@ -222,7 +225,8 @@ impl Topology {
             .triangles
             .par_iter()
             .map(|t| {
-                let v = t.map(|c| welded_of_vertex[c as usize]);
+                let welded = |k: usize| welded_of_vertex[t[k] as usize];
+                let v = [welded(0), welded(1), welded(2)];
                 (v, is_degenerate(&v, &welded_positions))
             })
             .unzip();
@@ -252,13 +256,16 @@ impl Topology {
             })
             .unzip();
 
+        // A plain loop over the three sides: the closure of `array::from_fn` is not always
+        // inlined, and then costs a call per side.
         let neighbours: Vec<[PackedNeighbour; 3]> = (0..tri_verts.len())
             .into_par_iter()
             .map(|f| {
-                std::array::from_fn(|kf| {
+                let mut codes = [NO_NEIGHBOUR; 3];
+                for (kf, code) in codes.iter_mut().enumerate() {
                     let e = tri_edges[f][kf].0 as usize;
                     if edge_kinds[e] != EdgeKind::Interior {
-                        return NO_NEIGHBOUR;
+                        continue;
                     }
                     let here = EdgeUse::new(TriId(f as u32), kf as u8);
                     let pair = uses_of(e);
@@ -267,8 +274,9 @@ impl Topology {
                     // f's corner i sits in g's slot r + 1 or r + 2 (r = kg, opposite the edge).
                     let i = tri_verts[f][(kf + 1) % 3];
                     let swapped = tri_verts[g][(kg + 1) % 3] != i;
-                    (other.0 << 1) | u32::from(swapped)
-                })
+                    *code = (other.0 << 1) | u32::from(swapped);
+                }
+                codes
             })
             .collect();
 
@@ -395,80 +403,6 @@ impl Topology {
     }
 }
 
-/// Welds bit-equal positions (after mapping -0.0 to +0.0), numbering them by first use.
-///
-/// Sorting (hash, index) pairs groups equal positions with their first use at the head: half
-/// the memory of a hash map over every vertex, and parallel. The pairs are 16 bytes where the
-/// (position bits, index) pairs they replace were 32, which halves what the sort moves; the
-/// rare run of equal hashes is ordered by the position bits themselves, so the result is the
-/// one a sort by position gives, whatever the hash.
-fn weld(positions: &[DVec3]) -> (Vec<VertId>, Vec<DVec3>) {
-    weld_by(positions, position_hash)
-}
-
-/// [`weld`] with the hash given, so that tests can make every position collide.
-fn weld_by(
-    positions: &[DVec3],
-    hash: impl Fn([u64; 3]) -> u64 + Sync,
-) -> (Vec<VertId>, Vec<DVec3>) {
-    // x + 0.0 is +0.0 for x = -0.0 and x itself otherwise.
-    let key = |i: u32| {
-        let p = positions[i as usize];
-        [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits)
-    };
-    let mut sorted: Vec<(u64, u32)> = (0..positions.len() as u32)
-        .into_par_iter()
-        .map(|i| (hash(key(i)), i))
-        .collect();
-    // Entries are distinct (the index differs), so the parallel sort's order is the one there is.
-    sorted.par_sort_unstable();
-    // `first[i]`: the first input vertex at vertex i's position.
-    let mut first = vec![0u32; positions.len()];
-    let mut distinct = 0;
-    for run in sorted.chunk_by_mut(|a, b| a.0 == b.0) {
-        if run.len() == 1 {
-            let i = run[0].1;
-            distinct += 1;
-            first[i as usize] = i;
-            continue;
-        }
-        // Equal hashes: copies of one position, or (rarely) different positions.
-        run.sort_unstable_by_key(|&(_, i)| (key(i), i));
-        for group in run.chunk_by(|a, b| key(a.1) == key(b.1)) {
-            distinct += 1;
-            for &(_, i) in group {
-                first[i as usize] = group[0].1;
-            }
-        }
-    }
-    drop(sorted);
-    // In input order each first use takes the next id, and every later use (whose first use
-    // came before it) copies that id, in place.
-    let mut welded = Vec::with_capacity(distinct);
-    for i in 0..first.len() {
-        let r = first[i] as usize;
-        first[i] = if r == i {
-            welded.push(positions[i]);
-            welded.len() as u32 - 1
-        } else {
-            first[r]
-        };
-    }
-    (first.into_iter().map(VertId).collect(), welded)
-}
-
-/// A 64-bit hash of a position's bits: equal bits give equal hashes. Each coordinate passes
-/// through the SplitMix64 finalizer, so that positions read from `f32` (whose low 29 bits are
-/// zero) still spread over every bit.
-fn position_hash(bits: [u64; 3]) -> u64 {
-    fn mix(mut z: u64) -> u64 {
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    mix(mix(mix(bits[0]) ^ bits[1]) ^ bits[2])
-}
-
 /// The uses of all edges grouped edge by edge, and what indexes them.
 struct Grouped {
     uses: Vec<EdgeUse>,
@@ -545,15 +479,18 @@ fn group_uses(tri_verts: &[[VertId; 3]], vertex_count: usize) -> Grouped {
         });
     drop(ends);
 
+    // A plain loop over the three sides, as for the neighbours.
     let tri_edges = tri_verts
         .par_iter()
         .map(|v| {
-            std::array::from_fn(|k| {
+            let mut edges = [EdgeId(0); 3];
+            for (k, edge) in edges.iter_mut().enumerate() {
                 let (a, b) = ordered(v[(k + 1) % 3], v[(k + 2) % 3]);
                 let from = first_edge[a.0 as usize] as usize;
                 let of_a = &edge_verts[from..first_edge[a.0 as usize + 1] as usize];
-                EdgeId((from + of_a.partition_point(|e| e[1] < b)) as u32)
-            })
+                *edge = EdgeId((from + of_a.partition_point(|e| e[1] < b)) as u32);
+            }
+            edges
         })
         .collect();
     Grouped {
@@ -737,6 +674,7 @@ fn has_split_normals(
 
 #[cfg(test)]
 pub(crate) mod tests {
+    use super::weld::weld_by;
     use super::*;
 
     #[test]
