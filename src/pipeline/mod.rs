@@ -360,7 +360,8 @@ fn prepare_document(
     asset: &Path,
     options: &Options,
 ) -> Result<(AssetSharpness, FileReport, Vec<MeshInput>), Error> {
-    let sharpness = asset_sharpness(doc, asset, options)?;
+    // Smoothing reads only the effective widths.
+    let sharpness = asset_sharpness(doc, asset, options)?.effective_only();
     let level = sharpness.level().unwrap_or(options.level);
 
     // Refuse what would not fit before decoding or allocating any of it. Per-edge counts are

@@ -107,7 +107,8 @@ pub struct PrimitiveContext<'a> {
 /// One h per welded edge (indexed by [`crate::topology::EdgeId`]), why, and what looked odd.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeParams {
-    /// The h each edge's sources ask for (what `--explain-h` shows), in range.
+    /// The h each edge's sources ask for (what `--explain-h` shows), in range; empty when the
+    /// asset was made [`AssetSharpness::effective_only`].
     pub h: Vec<f64>,
     /// The h each edge is built with: `h` clamped to √2/4 on interior edges, 0 on boundary,
     /// non-manifold and degenerate ones. Decided once here; the surfaces, the tessellator's
@@ -163,6 +164,9 @@ pub struct AssetSharpness {
     /// Whether [`EdgeParams::sources`] is filled: only `--explain-h` reads it, and at 32 bytes
     /// per edge it is not built otherwise.
     keep_sources: bool,
+    /// Whether [`EdgeParams::h`] is filled: smoothing reads only the effective widths, and the
+    /// requested ones (8 bytes per edge) are then not built.
+    keep_requested: bool,
 }
 
 impl AssetSharpness {
@@ -206,6 +210,7 @@ impl AssetSharpness {
             section_of_mesh,
             defaults,
             keep_sources: false,
+            keep_requested: true,
         })
     }
 
@@ -213,6 +218,14 @@ impl AssetSharpness {
     /// [`EdgeParams::sources`] is empty.
     pub fn with_sources(mut self) -> Self {
         self.keep_sources = true;
+        self
+    }
+
+    /// The same, leaving [`EdgeParams::h`] empty: for smoothing, which reads only
+    /// [`EdgeParams::effective`]. Every effective width is the one a full resolution gives.
+    /// Ignored where the sources are kept, which are explained beside the requested h.
+    pub fn effective_only(mut self) -> Self {
+        self.keep_requested = false;
         self
     }
 

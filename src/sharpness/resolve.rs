@@ -180,7 +180,7 @@ pub(crate) fn resolve(
                 )
             })
             .unzip()
-    } else {
+    } else if asset.keep_requested {
         let (h, effective) = topo
             .par_edges()
             .enumerate()
@@ -190,6 +190,13 @@ pub(crate) fn resolve(
             })
             .unzip();
         (h, (effective, Vec::new()))
+    } else {
+        let effective = topo
+            .par_edges()
+            .enumerate()
+            .map(|e| EffectiveH::of_edge(e.1.kind, pick(&e).value()))
+            .collect();
+        (Vec::new(), (effective, Vec::new()))
     };
     Ok(EdgeParams {
         h,

@@ -227,6 +227,36 @@ fn edge_entries_beat_each_other_in_order_and_beat_the_crease_rule() {
     assert_eq!(r.h_at_dihedral(0.0), vec![0.04; 6], "sidecar mesh default");
 }
 
+/// Smoothing resolves only the effective widths: every one is what the full resolution gives,
+/// under every source (edge entries at each level, the crease rule, each default), and the
+/// requested widths are left unbuilt.
+#[test]
+fn effective_widths_alone_match_the_full_resolution() {
+    let (mesh, prim) = cube_extras();
+    let cases = [
+        Case::new(cube())
+            .sidecar(CUBE_SIDECAR_ALL)
+            .mesh_extras(mesh)
+            .prim_extras(0, prim),
+        Case::new(cube()).mesh_extras(json!({"g2tess": {"h": 0.2, "crease_angle": 60}})),
+        Case::new(cube()).sidecar("h = 0.07\n[mesh.0]\nh = 0.3\n"),
+        Case::new(hinge(30.0)).sidecar("[mesh.\"Body\"]\nedges = [{ a = 1, b = 0, h = 0.01 }]\n"),
+    ];
+    for (i, mut case) in cases.into_iter().enumerate() {
+        let full = case.run().unwrap().params;
+        case.sources = false;
+        case.effective_only = true;
+        let only = case.run().unwrap().params;
+        assert_eq!(only.effective, full.effective, "case {i}");
+        assert!(full.effective.iter().any(|&h| h > 0.0), "case {i}");
+        assert_eq!((only.h.len(), only.sources.len()), (0, 0), "case {i}");
+        assert_eq!(only.warnings, full.warnings, "case {i}");
+        // Where sources are kept, the requested widths are too.
+        case.sources = true;
+        assert_eq!(case.run().unwrap().params.h, full.h, "case {i}");
+    }
+}
+
 #[test]
 fn each_default_level_beats_the_next() {
     // Remove the default levels one at a time, strongest first; the face diagonals (flat, so

@@ -118,6 +118,8 @@ pub struct Case {
     pub mesh_names: Vec<Option<&'static str>>,
     /// Resolve which source set each edge (`--explain-h`'s data); on unless a test turns it off.
     pub sources: bool,
+    /// Resolve only the effective widths (what smoothing reads); off unless a test turns it on.
+    pub effective_only: bool,
 }
 
 impl Case {
@@ -130,6 +132,7 @@ impl Case {
             defaults: defaults(),
             mesh_names: vec![Some("Body")],
             sources: true,
+            effective_only: false,
         }
     }
 
@@ -160,6 +163,9 @@ impl Case {
                 .map_err(|e| e.to_string())?;
         if self.sources {
             asset = asset.with_sources();
+        }
+        if self.effective_only {
+            asset = asset.effective_only();
         }
         let prims: Vec<PrimitiveContext> = self
             .fixture
