@@ -33,13 +33,21 @@ const EXAMPLES: usize = 3;
 /// `index`), each naming the fallback applied.
 pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warning> {
     let mut out = Vec::new();
-    // One parallel pass over the triangles for every per-triangle test.
+    // One parallel pass over the triangles for every per-triangle test, which also marks the
+    // vertices their corners use (every store writes `true`, so the order the threads run in
+    // does not matter).
+    let used: Vec<AtomicBool> = (0..mesh.positions.len())
+        .map(|_| AtomicBool::new(false))
+        .collect();
     let sliver_cos = SLIVER_ANGLE.cos();
     let [degenerate, slivers, facing_away] = Tally::of_each(mesh.triangles.len(), |t| {
+        let tri = mesh.triangles[t];
+        for &c in &tri {
+            used[c as usize].store(true, Relaxed);
+        }
         if topo.degenerate[t] {
             return [true, false, false];
         }
-        let tri = mesh.triangles[t];
         let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
         let face = (b - a).cross(c - a);
         let away = tri
@@ -73,15 +81,6 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         });
     }
 
-    // Every store writes `true`, so the order the threads run in does not matter.
-    let used: Vec<AtomicBool> = (0..mesh.positions.len())
-        .map(|_| AtomicBool::new(false))
-        .collect();
-    mesh.triangles.par_iter().for_each(|t| {
-        for &c in t {
-            used[c as usize].store(true, Relaxed);
-        }
-    });
     let unused = Tally::of(used.len(), |v| !used[v].load(Relaxed));
     drop(used);
     if unused.count > 0 {
