@@ -4,6 +4,9 @@
 //! It deliberately knows nothing of blend widths or surfaces: it only describes the mesh, and
 //! reports bad geometry as [`Warning`]s instead of failing.
 //!
+//! The weld itself (which input vertices are one welded vertex, numbered by first use) is the
+//! submodule `weld`, parallel throughout.
+//!
 //! Conventions: corner `k` of a triangle is opposite its edge `k`; edge `k` runs from corner
 //! `(k + 1) % 3` (called `i`) to corner `(k + 2) % 3` (called `j`).
 

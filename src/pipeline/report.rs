@@ -124,7 +124,7 @@ impl EdgeFigures {
     /// Counts the edges of `topo` by kind under blend widths `h`, measuring nothing.
     ///
     /// Only each edge's kind is read (no edge view is assembled), in parallel blocks of
-    /// [`COUNT_BLOCK`] edges whose counts are summed: a million-triangle mesh has a million and
+    /// `COUNT_BLOCK` edges whose counts are summed: a million-triangle mesh has a million and
     /// a half edges, which one thread took a few milliseconds to count while the other waited.
     pub fn count(topo: &Topology, h: &[f64]) -> EdgeFigures {
         let edges = topo.edge_count();
