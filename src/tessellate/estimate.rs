@@ -49,8 +49,8 @@ pub(crate) struct Curvature {
 /// every `Q_ab` changes a sample's predicted error (at the centroid, `½ · 3 · (1/3)²`).
 const WEIGHT_GAIN: f64 = 1.0 / 6.0;
 
-/// Relative allowance for the rounding of [`worst_abs`]'s sums against the bound
-/// `WEIGHT_GAIN · max |q|`, which filters the points that cannot change a maximum.
+/// Relative allowance for the rounding of [`worst_abs`]'s sums against [`bound`], which filters
+/// the points that cannot change a maximum, and against the spread's `WEIGHT_GAIN` bounds.
 const BOUND_SLACK: f64 = 1.0 + 1e-12;
 
 /// The interior point of the level-`l` lattice nearest barycentrics `b`, as an index among the
@@ -689,6 +689,7 @@ mod tests {
             }
         }
     }
+
     /// `q` spread over magnitudes and signs, from a fixed-seed generator, with the cases
     /// where two or all three are equal or zero.
     fn sample_qs() -> Vec<[f64; 3]> {
