@@ -231,7 +231,9 @@ pub struct Options {
     /// ([`crate::pipeline::MeshReport::edges`], six extra surface evaluations per edge, up to a
     /// tenth of a run at low levels) and meshoptimizer's vertex cache figures of each output
     /// primitive ([`crate::pipeline::PrimitiveReport::cache`], a sequential pass over the index
-    /// buffer). It changes the report, never the output. Default: `false`.
+    /// buffer), and, at a uniform level 1 on the flat surface, the edge counts (there they are
+    /// the only reader of each edge's h). It changes the report, never the output. Default:
+    /// `false`.
     pub report_figures: bool,
     /// A flag the caller sets to stop the work early (the CLI's Ctrl-C and SIGTERM): polled
     /// between stages of every mesh, it fails the file with [`crate::pipeline::Error::Cancelled`]

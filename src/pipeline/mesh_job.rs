@@ -80,8 +80,10 @@ pub(super) struct Resolved {
     pub groups: Vec<Range<usize>>,
     /// Adjacency of `mesh`.
     pub topo: Topology,
-    /// One h per welded edge, with where each came from.
+    /// One h per welded edge, with where each came from; no widths where none are read.
     pub params: EdgeParams,
+    /// Whether anything reads the widths (see [`widths_read`]): without, `params` holds none.
+    pub widths_read: bool,
 }
 
 /// Checks and joins the primitives of `input`, welds them and resolves per-edge h; warnings
@@ -90,6 +92,20 @@ pub(super) fn resolve(
     input: &mut MeshInput,
     sharpness: &AssetSharpness,
     options: &Options,
+    asset: &Path,
+    warnings: &mut Vec<Warning>,
+) -> Result<Resolved, Error> {
+    resolve_for(input, sharpness, options, false, asset, warnings)
+}
+
+/// [`resolve`] for a tessellation that reads corners alone where `corners_only` (see
+/// [`surface_for`]): then, where nothing else reads them, no edge's h is picked (the entries
+/// are still checked).
+fn resolve_for(
+    input: &mut MeshInput,
+    sharpness: &AssetSharpness,
+    options: &Options,
+    corners_only: bool,
     asset: &Path,
     warnings: &mut Vec<Warning>,
 ) -> Result<Resolved, Error> {
@@ -133,6 +149,7 @@ pub(super) fn resolve(
         ));
     }
     let topo = Topology::build(&mesh);
+    let widths_read = widths_read(options, corners_only, &mesh, &prepared);
     let ctx = MeshContext {
         index: input.mesh,
         name: input.name.as_deref(),
@@ -142,7 +159,13 @@ pub(super) fn resolve(
     // The geometry checks only report: they run beside the resolution of h.
     let (checks, params) = rayon::join(
         || super::checks::mesh_warnings(input.mesh, &mesh, &topo),
-        || sharpness.resolve_mesh(&ctx, &mesh, &topo),
+        || {
+            if widths_read {
+                sharpness.resolve_mesh(&ctx, &mesh, &topo)
+            } else {
+                sharpness.check_mesh(&ctx, &mesh, &topo)
+            }
+        },
     );
     warnings.extend(checks);
     let params = params?;
@@ -158,7 +181,24 @@ pub(super) fn resolve(
         groups,
         topo,
         params,
+        widths_read,
     })
+}
+
+/// Whether any stage reads the mesh's blend widths. Only a run that tessellates on the flat
+/// surface and writes no report reads none: at a uniform level 1 every output vertex is an
+/// input corner, numbered by input vertex and written from the mesh (the tessellator's creases
+/// split only edge samples, and there are none), so the widths change no output bit. The
+/// report's edge counts read them ([`Options::report_figures`] asks for a report), as do the
+/// surfaces of morph targets and every other surface.
+fn widths_read(
+    options: &Options,
+    corners_only: bool,
+    mesh: &TriMesh,
+    prepared: &[Prepared],
+) -> bool {
+    let targets = prepared.iter().any(|p| !p.data.targets.is_empty());
+    options.report_figures || targets || !takes_flat_surface(options, corners_only, mesh)
 }
 
 /// Smooths one mesh at `level`; its decoded arrays are freed as they are used.
@@ -175,6 +215,14 @@ pub fn smooth_mesh(
         ..MeshReport::default()
     };
     stop_if_cancelled(options, asset)?;
+    // One level, or every level of the LOD chain from the one surface: only the counts and
+    // the tessellation are per level.
+    // The sidecar's density keys apply to each level as to one: a block that decides its
+    // mesh's density fixes it at every level.
+    let chain = sharpness.mesh_lod_levels(input.mesh, options);
+    // Only a single uniform level 1 with nothing measured reads corners alone.
+    let corners_only =
+        chain.is_empty() && !options.adaptive() && level == 1 && !options.report_figures;
     let clock = Instant::now();
     let Resolved {
         prepared,
@@ -182,10 +230,12 @@ pub fn smooth_mesh(
         groups,
         topo,
         params,
-    } = resolve(
+        widths_read,
+    } = resolve_for(
         &mut input,
         sharpness,
         options,
+        corners_only,
         asset,
         &mut report.warnings.0,
     )?;
@@ -201,15 +251,14 @@ pub fn smooth_mesh(
     } = params;
     drop((h, sources));
 
-    // One level, or every level of the LOD chain from the one surface: only the counts and
-    // the tessellation are per level.
-    // The sidecar's density keys apply to each level as to one: a block that decides its
-    // mesh's density fixes it at every level.
-    let chain = sharpness.mesh_lod_levels(input.mesh, options);
-    // Only a single uniform level 1 with nothing measured reads corners alone.
-    let corners_only =
-        chain.is_empty() && !options.adaptive() && level == 1 && !options.report_figures;
-    let (surface, surface_warnings) = surface_for(options, corners_only, &mesh, &topo, &effective);
+    // Where no width is read the flat surface is the one `surface_for` would take (the same
+    // test decided it), without testing every normal again.
+    let (surface, surface_warnings) = if widths_read {
+        surface_for(options, corners_only, &mesh, &topo, &effective)
+    } else {
+        let flat: Box<dyn Surface> = Box::new(FlatSurface::new(&mesh));
+        (flat, Vec::new())
+    };
     report.warnings.0.extend(
         surface_warnings
             .iter()
@@ -217,8 +266,11 @@ pub fn smooth_mesh(
     );
     report.edges = if options.report_figures {
         EdgeFigures::measure(surface.as_ref(), &topo, &effective)
-    } else {
+    } else if widths_read {
         EdgeFigures::count(&topo, &effective)
+    } else {
+        // Nothing reads the counts: no report is written.
+        EdgeFigures::default()
     };
     report.times.surface = lap(&clock, report.times.sharpness);
     stop_if_cancelled(options, asset)?;
@@ -456,11 +508,17 @@ pub(super) fn surface_for<'a>(
     topo: &'a Topology,
     h: &'a EffectiveH,
 ) -> (Box<dyn Surface + 'a>, Vec<scheme::Warning>) {
-    let interpolates_silently = matches!(options.scheme, Scheme::G2 | Scheme::Pn);
-    if corners_only && interpolates_silently && flat_is_exact(mesh) {
+    if takes_flat_surface(options, corners_only, mesh) {
         return (Box::new(FlatSurface::new(mesh)), Vec::new());
     }
     build_surface(options, mesh, topo, h)
+}
+
+/// Whether [`surface_for`] takes the flat surface for `mesh`: corners alone are read, the
+/// scheme's construction reports nothing, and every input normal has a direction.
+fn takes_flat_surface(options: &Options, corners_only: bool, mesh: &TriMesh) -> bool {
+    let interpolates_silently = matches!(options.scheme, Scheme::G2 | Scheme::Pn);
+    corners_only && interpolates_silently && flat_is_exact(mesh)
 }
 
 /// Checks a primitive's positions and normals, generating normals where there are none.

@@ -90,6 +90,9 @@ pub struct PrimitiveReport {
 /// The mesh's edges by kind, and the continuity of the surface across them, sampled at three
 /// points per edge away from the corners (where only G¹ is expected) when asked for
 /// ([`crate::options::Options::report_figures`]).
+///
+/// The counts read every edge's h, which a uniform level 1 on the flat surface otherwise never
+/// resolves: there, unless figures are asked for, they are left 0.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct EdgeFigures {
     /// Interior edges blended (h > 0).

@@ -17,11 +17,14 @@ use super::{mesh_label, AssetSharpness, EdgeParams, EffectiveH, MeshContext, Sha
 use crate::mesh::TriMesh;
 use crate::topology::{Edge, EdgeId, EdgeKind, Topology};
 
+/// Resolves every edge's h for the mesh `ctx` describes; with `widths` off, only binds and
+/// checks the edge entries (their errors and warnings), and picks no edge's h.
 pub(crate) fn resolve(
     asset: &AssetSharpness,
     ctx: &MeshContext<'_>,
     mesh: &TriMesh,
     topo: &Topology,
+    widths: bool,
 ) -> Result<EdgeParams, SharpnessError> {
     check_context(ctx, mesh, topo)?;
     let label = mesh_label(ctx.index, ctx.name);
@@ -57,6 +60,15 @@ pub(crate) fn resolve(
             .filter_map(|(b, p)| b.as_ref().map(|b| (b, Some(p.index)))),
     )?;
     let mesh_edges = explicit.level(mesh_block.iter().map(|b| (b, None)))?;
+    // Every error and warning of a resolution is found above: what follows only picks.
+    if !widths {
+        return Ok(EdgeParams {
+            h: Vec::new(),
+            effective: EffectiveH::default(),
+            sources: Vec::new(),
+            warnings,
+        });
+    }
 
     // Per primitive: the crease angle and the extras default h that apply on its side.
     let crease_of_prim: Vec<Option<&Located<f64>>> = prim_blocks

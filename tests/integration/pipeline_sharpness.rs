@@ -240,6 +240,25 @@ fn every_sidecar_mistake_fails_its_file_with_the_line() {
         ),
     ];
     for (sidecar, what, expected) in cases {
+        let check = |out: &std::process::Output, dir: &tempfile::TempDir| {
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
+            let line = stderr
+                .lines()
+                .find(|l| l.starts_with("g2tess: error:"))
+                .unwrap_or_else(|| panic!("{what}: no error line in {stderr}"));
+            for e in expected {
+                assert!(line.contains(e), "{what}: {line:?} lacks {e:?}");
+            }
+            assert!(
+                !dir.path().join("out/octa.gltf").exists(),
+                "{what}: output written"
+            );
+            assert!(
+                dir.path().join("out/good.gltf").exists(),
+                "{what}: good file not processed"
+            );
+        };
         let dir = corpus::temp_dir();
         std::fs::write(
             dir.path().join("octa.gltf"),
@@ -255,23 +274,15 @@ fn every_sidecar_mistake_fails_its_file_with_the_line() {
         .unwrap();
         std::fs::create_dir(dir.path().join("out")).unwrap();
         let out = run(dir.path(), &["octa.gltf", "good.gltf", "-o", "out"]);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
-        let line = stderr
-            .lines()
-            .find(|l| l.starts_with("g2tess: error:"))
-            .unwrap_or_else(|| panic!("{what}: no error line in {stderr}"));
-        for e in expected {
-            assert!(line.contains(e), "{what}: {line:?} lacks {e:?}");
-        }
-        assert!(
-            !dir.path().join("out/octa.gltf").exists(),
-            "{what}: output written"
+        check(&out, &dir);
+        // A uniform level 1 reads no edge's h, and checks the entries all the same.
+        std::fs::remove_dir_all(dir.path().join("out")).unwrap();
+        std::fs::create_dir(dir.path().join("out")).unwrap();
+        let out = run(
+            dir.path(),
+            &["octa.gltf", "good.gltf", "-o", "out", "--level", "1"],
         );
-        assert!(
-            dir.path().join("out/good.gltf").exists(),
-            "{what}: good file not processed"
-        );
+        check(&out, &dir);
     }
 }
 

@@ -257,6 +257,48 @@ fn effective_widths_alone_match_the_full_resolution() {
     }
 }
 
+/// A run that reads no width still binds and checks every edge entry: the same warnings, and
+/// the same error for an entry naming no edge and for two values on one edge, at every level
+/// of entries; it picks no width.
+#[test]
+fn checking_the_entries_alone_finds_what_the_full_resolution_finds() {
+    let (mesh, prim) = cube_extras();
+    let good = [
+        Case::new(hinge(0.0)).sidecar("[mesh.0]\nedges = [{ a = 0, b = 2, h = 0.1 }]\n"),
+        Case::new(cube())
+            .sidecar(CUBE_SIDECAR_ALL)
+            .mesh_extras(mesh)
+            .prim_extras(0, prim),
+    ];
+    for (i, mut case) in good.into_iter().enumerate() {
+        let full = case.run().unwrap().params;
+        case.entries_only = true;
+        let only = case.run().unwrap().params;
+        assert_eq!(only.warnings, full.warnings, "case {i}");
+        let widths = (only.h.len(), only.effective.len(), only.sources.len());
+        assert_eq!(widths, (0, 0, 0), "case {i}");
+    }
+    assert!(!Case::new(hinge(0.0))
+        .sidecar("[mesh.0]\nedges = [{ a = 0, b = 2, h = 0.1 }]\n")
+        .run()
+        .unwrap()
+        .params
+        .warnings
+        .is_empty());
+    let bad = [
+        Case::new(hinge(0.0)).sidecar("[mesh.0]\nedges = [{ a = 0, b = 9, h = 0.1 }]\n"),
+        Case::new(hinge(0.0))
+            .sidecar("[mesh.0]\nedges = [{ a = 0, b = 1, h = 0.0 }, { a = 1, b = 0, h = 0.1 }]\n"),
+        Case::new(hinge(0.0)).mesh_extras(json!({"g2tess": {"edges": [
+            {"a": 0, "b": 1, "h": 0.0}, {"a": 1, "b": 0, "h": 0.1}]}})),
+    ];
+    for (i, mut case) in bad.into_iter().enumerate() {
+        let full = case.error();
+        case.entries_only = true;
+        assert_eq!(case.error(), full, "case {i}");
+    }
+}
+
 #[test]
 fn each_default_level_beats_the_next() {
     // Remove the default levels one at a time, strongest first; the face diagonals (flat, so

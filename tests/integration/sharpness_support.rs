@@ -120,6 +120,9 @@ pub struct Case {
     pub sources: bool,
     /// Resolve only the effective widths (what smoothing reads); off unless a test turns it on.
     pub effective_only: bool,
+    /// Check the edge entries alone, picking no width (what a run that reads none does); off
+    /// unless a test turns it on.
+    pub entries_only: bool,
 }
 
 impl Case {
@@ -133,6 +136,7 @@ impl Case {
             mesh_names: vec![Some("Body")],
             sources: true,
             effective_only: false,
+            entries_only: false,
         }
     }
 
@@ -186,9 +190,12 @@ impl Case {
             primitives: &prims,
         };
         let topo = Topology::build(&self.fixture.mesh);
-        let params = asset
-            .resolve_mesh(&ctx, &self.fixture.mesh, &topo)
-            .map_err(|e| e.to_string())?;
+        let params = if self.entries_only {
+            asset.check_mesh(&ctx, &self.fixture.mesh, &topo)
+        } else {
+            asset.resolve_mesh(&ctx, &self.fixture.mesh, &topo)
+        }
+        .map_err(|e| e.to_string())?;
         Ok(Resolved { params, topo })
     }
 
