@@ -11,7 +11,9 @@ use rayon::prelude::*;
 use super::neighbour_net::{compose_across, Reach, SoaNet};
 use super::net_memo::{self, Local};
 use super::nets::Nets;
-use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, LANES};
+use super::pattern::{
+    EdgeRows, Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, EDGE_VALUE_ROWS,
+};
 use super::pn::{Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
@@ -257,23 +259,25 @@ impl<'a> G2Surface<'a> {
     /// Each lane's sums run in the same order whatever `L`, so a lattice block and a single
     /// point agree bit for bit.
     ///
-    /// Only the control points `rows` are summed (in slot order): [`ALL_ROWS`], or, where the
-    /// pattern found every other weight exactly zero, [`EDGE_ROWS`]`[k]`. Leaving such a term
-    /// out leaves every bit as it was: the sums start at `+0` and so are never `−0` (in
+    /// Only the control points `value_rows` are summed for the position and `rows` for the two
+    /// tangents (each in slot order): [`ALL_ROWS`] for both, or, where the pattern found every
+    /// other weight exactly zero, [`EDGE_ROWS`]`[k]` and [`EDGE_VALUE_ROWS`]`[k]`. Leaving such
+    /// a term out leaves every bit as it was: the sums start at `+0` and so are never `−0` (in
     /// round-to-nearest `a + b = −0` only when both are `−0`), the nets are finite (finite
     /// `f32` positions, unit normals, bounded handles), so each left-out term `±0·x` is `±0`,
     /// and adding `±0` to a sum that is not `−0` does not change it.
     #[inline(always)]
-    fn combine<const L: usize, const R: usize>(
+    fn combine<const L: usize, const V: usize, const R: usize>(
         normal: &[DVec3; 3],
         w: &Lanes<L>,
-        own: &Broadcast<L>,
-        across: Option<&Broadcast<L>>,
+        own: &SoaNet,
+        across: Option<&SoaNet>,
+        value_rows: &[usize; V],
         rows: &[usize; R],
     ) -> [SurfacePoint; L] {
-        let mut acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], rows);
+        let mut acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], value_rows, rows);
         if let Some(across) = across {
-            acc = accumulate(&w.across, across, acc, rows);
+            acc = accumulate(&w.across, across, acc, value_rows, rows);
         }
         std::array::from_fn(|l| {
             let v = |q: usize| DVec3::new(acc[q][0][l], acc[q][1][l], acc[q][2][l]);
@@ -298,44 +302,64 @@ impl<'a> G2Surface<'a> {
             SurfacePoint { position, normal }
         })
     }
+
+    /// [`G2Surface::combine`] with the rows a pattern's `edge_rows` allows (see there).
+    #[inline(always)]
+    fn combine_rows<const L: usize>(
+        normal: &[DVec3; 3],
+        w: &Lanes<L>,
+        own: &SoaNet,
+        across: Option<&SoaNet>,
+        edge_rows: EdgeRows,
+    ) -> [SurfacePoint; L] {
+        match edge_rows {
+            EdgeRows::All => Self::combine(normal, w, own, across, &ALL_ROWS, &ALL_ROWS),
+            EdgeRows::Edge(k) => {
+                let rows = &EDGE_ROWS[k as usize];
+                Self::combine(normal, w, own, across, rows, rows)
+            }
+            EdgeRows::EdgeValues(k) => {
+                let k = k as usize;
+                Self::combine(normal, w, own, across, &EDGE_VALUE_ROWS[k], &EDGE_ROWS[k])
+            }
+        }
+    }
 }
 
 /// Every control point, in slot order: the rows [`G2Surface::combine`] sums by default.
 const ALL_ROWS: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9];
 
-/// A control net with every coordinate repeated in `L` lanes, `[control point][x, y, z][lane]`:
-/// the sums of [`accumulate`] are then the same operation on whole lanes, which compilers turn
-/// into SIMD arithmetic without being told.
-type Broadcast<const L: usize> = [[[f64; L]; 3]; 10];
-
-fn broadcast<const L: usize>(net: &SoaNet) -> Broadcast<L> {
-    // Plain loops: nested `array::map` closures were not inlined, and cost more than the sums.
-    let mut out = [[[0.0; L]; 3]; 10];
-    for (m, point) in out.iter_mut().enumerate() {
-        for (lanes, coord) in point.iter_mut().zip(net) {
-            *lanes = [coord[m]; L];
-        }
-    }
-    out
-}
-
 /// Adds the weighted sums of one net to `acc[quantity][coordinate][lane]`: for each lane, the
-/// control points in order, so that the result does not depend on how many lanes run together.
+/// control points in order (`value_rows` for the position, `rows` for the tangents), so that
+/// the result does not depend on how many lanes run together.
 ///
 /// The sums are taken and returned by value, and written as plain indexed loops: kept out of
-/// memory that way, the compiler unrolls them and runs the lanes in SIMD registers.
+/// memory that way, the compiler unrolls them and runs the lanes in SIMD registers. Each
+/// control point's coordinate is read once and repeated across the lanes in a register, the
+/// same value in every lane as a copy of the net laid out lane by lane would hold, without
+/// writing that copy (twice the net's bytes) for every triangle and neighbour.
 #[inline(always)]
-fn accumulate<const L: usize, const R: usize>(
+fn accumulate<const L: usize, const V: usize, const R: usize>(
     w: &NetWeights<L>,
-    net: &Broadcast<L>,
+    net: &SoaNet,
     mut acc: [[[f64; L]; 3]; 3],
+    value_rows: &[usize; V],
     rows: &[usize; R],
 ) -> [[[f64; L]; 3]; 3] {
+    for &m in value_rows {
+        for c in 0..3 {
+            let x = net[c][m];
+            for l in 0..L {
+                acc[0][c][l] += w[0][m][l] * x;
+            }
+        }
+    }
     for &m in rows {
-        for q in 0..3 {
+        for q in 1..3 {
             for c in 0..3 {
+                let x = net[c][m];
                 for l in 0..L {
-                    acc[q][c][l] += w[q][m][l] * net[m][c][l];
+                    acc[q][c][l] += w[q][m][l] * x;
                 }
             }
         }
@@ -456,25 +480,22 @@ fn set_point(mesh: &TriMesh, tri: usize, patch: &mut Patch, slot: usize, value: 
     }
 }
 
-/// One patch set up for single points: its net broadcast once, and each neighbour's net
+/// One patch set up for single points: its net rebuilt once, and each neighbour's net
 /// composed (Eq. 3) the first time a point blends across that edge, then kept. A single point
 /// and a batch of them run the same arithmetic, so they agree bit for bit.
 struct PointEvaluation {
     tri: usize,
     widths: [f64; 3],
     local: Local,
-    own: Broadcast<1>,
-    across: [Option<Broadcast<1>>; 3],
+    across: [Option<SoaNet>; 3],
 }
 
 impl PointEvaluation {
     fn new(surface: &G2Surface, tri: usize) -> Self {
-        let (local, own) = surface.with_local(tri, |local| (*local, broadcast(&local.net)));
         PointEvaluation {
             tri,
             widths: surface.widths(tri),
-            own,
-            local,
+            local: surface.with_local(tri, |local| *local),
             across: [None; 3],
         }
     }
@@ -491,14 +512,14 @@ impl PointEvaluation {
         let tri = self.tri;
         let net = w.blended.then(|| {
             let k = w.k as usize;
-            &*self.across[k]
-                .get_or_insert_with(|| broadcast(&surface.across_net(tri, k, Reach::Whole)))
+            &*self.across[k].get_or_insert_with(|| surface.across_net(tri, k, Reach::Whole))
         });
         let [p] = G2Surface::combine(
             &self.local.normal,
             &Lanes::<1>::single(&w),
-            &self.own,
+            &self.local.net,
             net,
+            &ALL_ROWS,
             &ALL_ROWS,
         );
         p
@@ -511,7 +532,7 @@ impl Surface for G2Surface<'_> {
         out.at(self, bary)
     }
 
-    /// [`Surface::evaluate`] point by point, with the own net broadcast and each neighbour's
+    /// [`Surface::evaluate`] point by point, with the own net rebuilt and each neighbour's
     /// net composed once for all of them instead of once per point.
     fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
         let mut points = PointEvaluation::new(self, tri);
@@ -529,7 +550,7 @@ impl Surface for G2Surface<'_> {
     }
 
     /// [`Surface::evaluate_lattice_part`] part after part, with the triangle's own net rebuilt
-    /// and broadcast once, and each neighbour's net composed (Eq. 3) once for every part that
+    /// once, and each neighbour's net composed (Eq. 3) once for every part that
     /// blends across its edge (an edge and the interior both do), instead of once per part;
     /// only its edge row when the parts are all edges.
     fn evaluate_lattice_parts(
@@ -545,7 +566,7 @@ impl Surface for G2Surface<'_> {
     }
 }
 
-/// One patch set up for lattice parts: its net rebuilt and broadcast once, and each
+/// One patch set up for lattice parts: its net rebuilt once, and each
 /// neighbour's net composed (Eq. 3) the first time a part blends across that edge, then kept.
 /// The values are those a part evaluated alone computes, so parts evaluated together or apart
 /// agree bit for bit.
@@ -554,9 +575,8 @@ struct PartEvaluation<'s, 'a> {
     tri: usize,
     widths: [f64; 3],
     local: Local,
-    own: Broadcast<LANES>,
     /// Each neighbour's composed net, and how much of it was composed.
-    across: [Option<(Reach, Broadcast<LANES>)>; 3],
+    across: [Option<(Reach, SoaNet)>; 3],
     /// Whether every part asked for is an edge: then a neighbour's net is only ever weighed on
     /// its own edge, and its edge row is all that is composed ([`Reach::Edge`]).
     edges_only: bool,
@@ -566,13 +586,11 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
     /// The set-up for the lattice parts `parts` of triangle `tri`.
     #[inline]
     fn new(surface: &'s G2Surface<'a>, tri: usize, parts: &[(u32, LatticePart)]) -> Self {
-        let (local, own) = surface.with_local(tri, |local| (*local, broadcast(&local.net)));
         PartEvaluation {
             surface,
             tri,
             widths: surface.widths(tri),
-            own,
-            local,
+            local: surface.with_local(tri, |local| *local),
             across: [None; 3],
             edges_only: parts
                 .iter()
@@ -588,7 +606,6 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
             tri,
             widths,
             local,
-            own,
             across,
             edges_only,
         } = self;
@@ -610,12 +627,13 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                         normal: local.normal[c as usize],
                     };
                 }
-                let groups = std::iter::once((None, &pattern.plain))
-                    .chain((0..3).map(|k| (Some(k), &pattern.blended[k])));
-                for (k, blocks) in groups {
-                    if blocks.is_empty() {
+                // The plain points first, then those blended across each edge.
+                for group in [3, 0, 1, 2] {
+                    let (blocks, single) = pattern.group(group);
+                    if blocks.is_empty() && single.is_none() {
                         continue;
                     }
+                    let k = (group < 3).then_some(group);
                     let across = k.map(|k| {
                         // Points of edge k blend only across edge k; any other part may weigh
                         // the whole net.
@@ -627,29 +645,33 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                         let cached = &mut across[k];
                         if !matches!(*cached, Some((had, _)) if had == Reach::Whole || had == reach)
                         {
-                            let net = surface.across_net(*tri, k, reach);
-                            *cached = Some((reach, broadcast(&net)));
+                            *cached = Some((reach, surface.across_net(*tri, k, reach)));
                         }
                         &cached.as_ref().expect("composed just above").1
                     });
                     for lanes in blocks {
-                        let points = match pattern.edge_rows {
-                            Some(k) => G2Surface::combine(
-                                &local.normal,
-                                lanes,
-                                own,
-                                across,
-                                &EDGE_ROWS[k as usize],
-                            ),
-                            None => {
-                                G2Surface::combine(&local.normal, lanes, own, across, &ALL_ROWS)
-                            }
-                        };
+                        let points = G2Surface::combine_rows(
+                            &local.normal,
+                            lanes,
+                            &local.net,
+                            across,
+                            pattern.edge_rows,
+                        );
                         for (&target, p) in lanes.target.iter().zip(points) {
                             if target != Lanes::<1>::PADDING {
                                 out[target as usize] = p;
                             }
                         }
+                    }
+                    if let Some(lane) = single {
+                        let [p] = G2Surface::combine_rows(
+                            &local.normal,
+                            lane,
+                            &local.net,
+                            across,
+                            pattern.edge_rows,
+                        );
+                        out[lane.target[0] as usize] = p;
                     }
                 }
             });
