@@ -12,7 +12,7 @@ use super::neighbour_net::{compose_across, Reach, SoaNet};
 use super::net_memo::{self, Local};
 use super::nets::Nets;
 use super::pattern::{
-    EdgeRows, Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, EDGE_VALUE_ROWS,
+    EdgeRows, Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, EDGE_VALUE_ROWS, LANES,
 };
 use super::pn::{Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
@@ -259,26 +259,56 @@ impl<'a> G2Surface<'a> {
     /// Each lane's sums run in the same order whatever `L`, so a lattice block and a single
     /// point agree bit for bit.
     ///
-    /// Only the control points `value_rows` are summed for the position and `rows` for the two
-    /// tangents (each in slot order): [`ALL_ROWS`] for both, or, where the pattern found every
-    /// other weight exactly zero, [`EDGE_ROWS`]`[k]` and [`EDGE_VALUE_ROWS`]`[k]`. Leaving such
-    /// a term out leaves every bit as it was: the sums start at `+0` and so are never `−0` (in
-    /// round-to-nearest `a + b = −0` only when both are `−0`), the nets are finite (finite
-    /// `f32` positions, unit normals, bounded handles), so each left-out term `±0·x` is `±0`,
-    /// and adding `±0` to a sum that is not `−0` does not change it.
+    /// Only the control points `edge_rows` names are summed (in slot order): all ten, or, where
+    /// the pattern found every other weight exactly zero, [`EDGE_ROWS`]`[k]`, and for the
+    /// position of a one-lane block [`EDGE_VALUE_ROWS`]`[k]`. Leaving such a term out leaves
+    /// every bit as it was: the sums start at `+0` and so are never `−0` (in round-to-nearest
+    /// `a + b = −0` only when both are `−0`), the nets are finite (finite `f32` positions, unit
+    /// normals, bounded handles), so each left-out term `±0·x` is `±0`, and adding `±0` to a
+    /// sum that is not `−0` does not change it.
     #[inline(always)]
-    fn combine<const L: usize, const V: usize, const R: usize>(
+    fn combine<const L: usize, N: LaneNet<L>>(
         normal: &[DVec3; 3],
         w: &Lanes<L>,
-        own: &SoaNet,
-        across: Option<&SoaNet>,
-        value_rows: &[usize; V],
-        rows: &[usize; R],
+        own: &N,
+        across: Option<&N>,
+        edge_rows: EdgeRows,
     ) -> [SurfacePoint; L] {
-        let mut acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], value_rows, rows);
-        if let Some(across) = across {
-            acc = accumulate(&w.across, across, acc, value_rows, rows);
-        }
+        let sums = |rows: &[usize; 7], value_rows: &[usize; 4]| {
+            // Two lanes share each net's load between the three quantities; one lane has no
+            // such load to share, and skips the three position terms that are zero.
+            if L == 1 {
+                let acc = accumulate_split(&w.own, own, [[[0.0; L]; 3]; 3], value_rows, rows);
+                match across {
+                    Some(across) => accumulate_split(&w.across, across, acc, value_rows, rows),
+                    None => acc,
+                }
+            } else {
+                let acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], rows);
+                match across {
+                    Some(across) => accumulate(&w.across, across, acc, rows),
+                    None => acc,
+                }
+            }
+        };
+        let acc = match edge_rows {
+            EdgeRows::All => {
+                let acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], &ALL_ROWS);
+                match across {
+                    Some(across) => accumulate(&w.across, across, acc, &ALL_ROWS),
+                    None => acc,
+                }
+            }
+            EdgeRows::Edge(k) => {
+                let rows = &EDGE_ROWS[k as usize];
+                let acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], rows);
+                match across {
+                    Some(across) => accumulate(&w.across, across, acc, rows),
+                    None => acc,
+                }
+            }
+            EdgeRows::EdgeValues(k) => sums(&EDGE_ROWS[k as usize], &EDGE_VALUE_ROWS[k as usize]),
+        };
         std::array::from_fn(|l| {
             let v = |q: usize| DVec3::new(acc[q][0][l], acc[q][1][l], acc[q][2][l]);
             let (position, du, dv) = (v(0), v(1), v(2));
@@ -302,64 +332,97 @@ impl<'a> G2Surface<'a> {
             SurfacePoint { position, normal }
         })
     }
-
-    /// [`G2Surface::combine`] with the rows a pattern's `edge_rows` allows (see there).
-    #[inline(always)]
-    fn combine_rows<const L: usize>(
-        normal: &[DVec3; 3],
-        w: &Lanes<L>,
-        own: &SoaNet,
-        across: Option<&SoaNet>,
-        edge_rows: EdgeRows,
-    ) -> [SurfacePoint; L] {
-        match edge_rows {
-            EdgeRows::All => Self::combine(normal, w, own, across, &ALL_ROWS, &ALL_ROWS),
-            EdgeRows::Edge(k) => {
-                let rows = &EDGE_ROWS[k as usize];
-                Self::combine(normal, w, own, across, rows, rows)
-            }
-            EdgeRows::EdgeValues(k) => {
-                let k = k as usize;
-                Self::combine(normal, w, own, across, &EDGE_VALUE_ROWS[k], &EDGE_ROWS[k])
-            }
-        }
-    }
 }
 
 /// Every control point, in slot order: the rows [`G2Surface::combine`] sums by default.
 const ALL_ROWS: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9];
 
+/// A control net with every coordinate repeated in `L` lanes, `[control point][x, y, z][lane]`:
+/// the sums of [`accumulate`] are then the same operation on whole lanes, which compilers turn
+/// into SIMD arithmetic without being told. Made only for blocks of two or more lanes: a
+/// one-lane block reads the [`SoaNet`] itself (a level-2 run then makes no copy at all).
+type Broadcast<const L: usize> = [[[f64; L]; 3]; 10];
+
+fn broadcast<const L: usize>(net: &SoaNet) -> Broadcast<L> {
+    // Plain loops: nested `array::map` closures were not inlined, and cost more than the sums.
+    let mut out = [[[0.0; L]; 3]; 10];
+    for (m, point) in out.iter_mut().enumerate() {
+        for (lanes, coord) in point.iter_mut().zip(net) {
+            *lanes = [coord[m]; L];
+        }
+    }
+    out
+}
+
+/// A net as the sums of `L` lanes read it: coordinate `c` of control point `m` in every lane.
+/// The same value whichever layout it comes from, so the sums have the same bits.
+trait LaneNet<const L: usize> {
+    fn lanes(&self, m: usize, c: usize) -> [f64; L];
+}
+
+impl<const L: usize> LaneNet<L> for Broadcast<L> {
+    #[inline(always)]
+    fn lanes(&self, m: usize, c: usize) -> [f64; L] {
+        self[m][c]
+    }
+}
+
+impl LaneNet<1> for SoaNet {
+    #[inline(always)]
+    fn lanes(&self, m: usize, c: usize) -> [f64; 1] {
+        [self[c][m]]
+    }
+}
+
 /// Adds the weighted sums of one net to `acc[quantity][coordinate][lane]`: for each lane, the
-/// control points in order (`value_rows` for the position, `rows` for the tangents), so that
-/// the result does not depend on how many lanes run together.
+/// control points in order, so that the result does not depend on how many lanes run together.
 ///
 /// The sums are taken and returned by value, and written as plain indexed loops: kept out of
-/// memory that way, the compiler unrolls them and runs the lanes in SIMD registers. Each
-/// control point's coordinate is read once and repeated across the lanes in a register, the
-/// same value in every lane as a copy of the net laid out lane by lane would hold, without
-/// writing that copy (twice the net's bytes) for every triangle and neighbour.
+/// memory that way, the compiler unrolls them and runs the lanes in SIMD registers.
 #[inline(always)]
-fn accumulate<const L: usize, const V: usize, const R: usize>(
+fn accumulate<const L: usize, const R: usize, N: LaneNet<L>>(
     w: &NetWeights<L>,
-    net: &SoaNet,
+    net: &N,
+    mut acc: [[[f64; L]; 3]; 3],
+    rows: &[usize; R],
+) -> [[[f64; L]; 3]; 3] {
+    for &m in rows {
+        for q in 0..3 {
+            for c in 0..3 {
+                let x = net.lanes(m, c);
+                for l in 0..L {
+                    acc[q][c][l] += w[q][m][l] * x[l];
+                }
+            }
+        }
+    }
+    acc
+}
+
+/// [`accumulate`] with the position summed over `value_rows` only and the tangents over `rows`
+/// (each in slot order; the sums are independent, so the split changes no bit).
+#[inline(always)]
+fn accumulate_split<const L: usize, const V: usize, const R: usize, N: LaneNet<L>>(
+    w: &NetWeights<L>,
+    net: &N,
     mut acc: [[[f64; L]; 3]; 3],
     value_rows: &[usize; V],
     rows: &[usize; R],
 ) -> [[[f64; L]; 3]; 3] {
     for &m in value_rows {
         for c in 0..3 {
-            let x = net[c][m];
+            let x = net.lanes(m, c);
             for l in 0..L {
-                acc[0][c][l] += w[0][m][l] * x;
+                acc[0][c][l] += w[0][m][l] * x[l];
             }
         }
     }
     for &m in rows {
         for q in 1..3 {
             for c in 0..3 {
-                let x = net[c][m];
+                let x = net.lanes(m, c);
                 for l in 0..L {
-                    acc[q][c][l] += w[q][m][l] * x;
+                    acc[q][c][l] += w[q][m][l] * x[l];
                 }
             }
         }
@@ -519,8 +582,7 @@ impl PointEvaluation {
             &Lanes::<1>::single(&w),
             &self.local.net,
             net,
-            &ALL_ROWS,
-            &ALL_ROWS,
+            EdgeRows::All,
         );
         p
     }
@@ -575,11 +637,22 @@ struct PartEvaluation<'s, 'a> {
     tri: usize,
     widths: [f64; 3],
     local: Local,
+    /// The own net lane by lane, made when a block of two or more lanes first needs it.
+    own_lanes: Option<Broadcast<LANES>>,
     /// Each neighbour's composed net, and how much of it was composed.
-    across: [Option<(Reach, SoaNet)>; 3],
+    across: [Option<Across>; 3],
     /// Whether every part asked for is an edge: then a neighbour's net is only ever weighed on
     /// its own edge, and its edge row is all that is composed ([`Reach::Edge`]).
     edges_only: bool,
+}
+
+/// A neighbour's net composed across one edge, for [`PartEvaluation`].
+struct Across {
+    /// How much of it was composed.
+    reach: Reach,
+    net: SoaNet,
+    /// `net` lane by lane, made when a block of two or more lanes first needs it.
+    lanes: Option<Broadcast<LANES>>,
 }
 
 impl<'s, 'a> PartEvaluation<'s, 'a> {
@@ -591,7 +664,8 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
             tri,
             widths: surface.widths(tri),
             local: surface.with_local(tri, |local| *local),
-            across: [None; 3],
+            own_lanes: None,
+            across: [None, None, None],
             edges_only: parts
                 .iter()
                 .all(|&(_, part)| matches!(part, LatticePart::Edge(_))),
@@ -606,6 +680,7 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
             tri,
             widths,
             local,
+            own_lanes,
             across,
             edges_only,
         } = self;
@@ -634,7 +709,7 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                         continue;
                     }
                     let k = (group < 3).then_some(group);
-                    let across = k.map(|k| {
+                    if let Some(k) = k {
                         // Points of edge k blend only across edge k; any other part may weigh
                         // the whole net.
                         let reach = if *edges_only && part == LatticePart::Edge(k as u8) {
@@ -643,28 +718,40 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                             Reach::Whole
                         };
                         let cached = &mut across[k];
-                        if !matches!(*cached, Some((had, _)) if had == Reach::Whole || had == reach)
+                        if !matches!(cached, Some(had) if had.reach == Reach::Whole || had.reach == reach)
                         {
-                            *cached = Some((reach, surface.across_net(*tri, k, reach)));
+                            *cached = Some(Across {
+                                reach,
+                                net: surface.across_net(*tri, k, reach),
+                                lanes: None,
+                            });
                         }
-                        &cached.as_ref().expect("composed just above").1
-                    });
-                    for lanes in blocks {
-                        let points = G2Surface::combine_rows(
-                            &local.normal,
-                            lanes,
-                            &local.net,
-                            across,
-                            pattern.edge_rows,
-                        );
-                        for (&target, p) in lanes.target.iter().zip(points) {
-                            if target != Lanes::<1>::PADDING {
-                                out[target as usize] = p;
+                    }
+                    if !blocks.is_empty() {
+                        let own = &*own_lanes.get_or_insert_with(|| broadcast(&local.net));
+                        let across = k.map(|k| {
+                            let a = across[k].as_mut().expect("composed just above");
+                            &*a.lanes.get_or_insert_with(|| broadcast(&a.net))
+                        });
+                        for lanes in blocks {
+                            let points = G2Surface::combine(
+                                &local.normal,
+                                lanes,
+                                own,
+                                across,
+                                pattern.edge_rows,
+                            );
+                            for (&target, p) in lanes.target.iter().zip(points) {
+                                if target != Lanes::<1>::PADDING {
+                                    out[target as usize] = p;
+                                }
                             }
                         }
                     }
                     if let Some(lane) = single {
-                        let [p] = G2Surface::combine_rows(
+                        let across =
+                            k.map(|k| &across[k].as_ref().expect("composed just above").net);
+                        let [p] = G2Surface::combine(
                             &local.normal,
                             lane,
                             &local.net,
