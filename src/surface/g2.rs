@@ -380,6 +380,7 @@ impl LaneNet<1> for SoaNet {
 /// The sums are taken and returned by value, and written as plain indexed loops: kept out of
 /// memory that way, the compiler unrolls them and runs the lanes in SIMD registers.
 #[inline(always)]
+#[allow(clippy::needless_range_loop)] // Indexed loops are the form that unrolls into SIMD.
 fn accumulate<const L: usize, const R: usize, N: LaneNet<L>>(
     w: &NetWeights<L>,
     net: &N,
@@ -402,6 +403,7 @@ fn accumulate<const L: usize, const R: usize, N: LaneNet<L>>(
 /// [`accumulate`] with the position summed over `value_rows` only and the tangents over `rows`
 /// (each in slot order; the sums are independent, so the split changes no bit).
 #[inline(always)]
+#[allow(clippy::needless_range_loop)] // As in `accumulate`.
 fn accumulate_split<const L: usize, const V: usize, const R: usize, N: LaneNet<L>>(
     w: &NetWeights<L>,
     net: &N,

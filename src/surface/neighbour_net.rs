@@ -170,10 +170,14 @@ pub(super) fn compose_across(net_g: &SoaNet, k: usize, slots: [usize; 3], reach:
     }
 }
 
+/// An edge's composed points by where they come from: `(slot, neighbour slot)` for the four
+/// selections, `(slot, first difference)` for the three differences.
+type EdgeSources = ([(u8, u8); 4], [(u8, u8); 3]);
+
 /// `EDGE_SOURCE[k][p][q]`: for [`Reach::Edge`], the four composed slots with exponent 0 of
 /// `λ_k` and the neighbour slot each is (a selection), then the three with exponent 1 and the
 /// [`DEGREE2`] number of the first difference each is; both in slot order.
-const EDGE_SOURCE: [[[([(u8, u8); 4], [(u8, u8); 3]); 3]; 3]; 3] = {
+const EDGE_SOURCE: [[[EdgeSources; 3]; 3]; 3] = {
     let mut table = [[[([(0, 0); 4], [(0, 0); 3]); 3]; 3]; 3];
     let mut k = 0;
     while k < 3 {

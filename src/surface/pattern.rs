@@ -167,9 +167,9 @@ pub struct Pattern {
     /// `blended[k]`: points that blend with the neighbour across the edge opposite corner `k`.
     pub blended: [Vec<Lanes<LANES>>; 3],
     /// The last point of a group when it would fill only one lane of its block: `single[k]`
-    /// belongs with `blended[k]`, `single[3]` with `plain`. Summed one lane wide, it costs half
-    /// the arithmetic of a block whose other lane is padding, with the same bits (each lane's
-    /// sums are its own); at level 2 every edge part is such a point.
+    /// belongs with `blended[k]`, `single[3]` with `plain`. Summed one lane wide, it reads the
+    /// nets as they are, with no copy of them lane by lane, and with the same bits (each lane's
+    /// sums are its own); at level 2 every edge part is such a point, so no net is copied.
     pub single: [Option<Lanes<1>>; 4],
     /// Which control points the sums need ([`EdgeRows`]): found by looking at the weights,
     /// never assumed, and [`EdgeRows::All`] wherever a weight left out would not be zero.
