@@ -11,7 +11,9 @@ use rayon::prelude::*;
 use super::neighbour_net::{compose_across, Reach, SoaNet};
 use super::net_memo::{self, Local};
 use super::nets::Nets;
-use super::pattern::{Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, LANES};
+use super::pattern::{
+    EdgeRows, Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, EDGE_VALUE_ROWS, LANES,
+};
 use super::pn::{Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
@@ -257,24 +259,56 @@ impl<'a> G2Surface<'a> {
     /// Each lane's sums run in the same order whatever `L`, so a lattice block and a single
     /// point agree bit for bit.
     ///
-    /// Only the control points `rows` are summed (in slot order): [`ALL_ROWS`], or, where the
-    /// pattern found every other weight exactly zero, [`EDGE_ROWS`]`[k]`. Leaving such a term
-    /// out leaves every bit as it was: the sums start at `+0` and so are never `−0` (in
-    /// round-to-nearest `a + b = −0` only when both are `−0`), the nets are finite (finite
-    /// `f32` positions, unit normals, bounded handles), so each left-out term `±0·x` is `±0`,
-    /// and adding `±0` to a sum that is not `−0` does not change it.
+    /// Only the control points `edge_rows` names are summed (in slot order): all ten, or, where
+    /// the pattern found every other weight exactly zero, [`EDGE_ROWS`]`[k]`, and for the
+    /// position of a one-lane block [`EDGE_VALUE_ROWS`]`[k]`. Leaving such a term out leaves
+    /// every bit as it was: the sums start at `+0` and so are never `−0` (in round-to-nearest
+    /// `a + b = −0` only when both are `−0`), the nets are finite (finite `f32` positions, unit
+    /// normals, bounded handles), so each left-out term `±0·x` is `±0`, and adding `±0` to a
+    /// sum that is not `−0` does not change it.
     #[inline(always)]
-    fn combine<const L: usize, const R: usize>(
+    fn combine<const L: usize, N: LaneNet<L>>(
         normal: &[DVec3; 3],
         w: &Lanes<L>,
-        own: &Broadcast<L>,
-        across: Option<&Broadcast<L>>,
-        rows: &[usize; R],
+        own: &N,
+        across: Option<&N>,
+        edge_rows: EdgeRows,
     ) -> [SurfacePoint; L] {
-        let mut acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], rows);
-        if let Some(across) = across {
-            acc = accumulate(&w.across, across, acc, rows);
-        }
+        let sums = |rows: &[usize; 7], value_rows: &[usize; 4]| {
+            // Two lanes share each net's load between the three quantities; one lane has no
+            // such load to share, and skips the three position terms that are zero.
+            if L == 1 {
+                let acc = accumulate_split(&w.own, own, [[[0.0; L]; 3]; 3], value_rows, rows);
+                match across {
+                    Some(across) => accumulate_split(&w.across, across, acc, value_rows, rows),
+                    None => acc,
+                }
+            } else {
+                let acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], rows);
+                match across {
+                    Some(across) => accumulate(&w.across, across, acc, rows),
+                    None => acc,
+                }
+            }
+        };
+        let acc = match edge_rows {
+            EdgeRows::All => {
+                let acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], &ALL_ROWS);
+                match across {
+                    Some(across) => accumulate(&w.across, across, acc, &ALL_ROWS),
+                    None => acc,
+                }
+            }
+            EdgeRows::Edge(k) => {
+                let rows = &EDGE_ROWS[k as usize];
+                let acc = accumulate(&w.own, own, [[[0.0; L]; 3]; 3], rows);
+                match across {
+                    Some(across) => accumulate(&w.across, across, acc, rows),
+                    None => acc,
+                }
+            }
+            EdgeRows::EdgeValues(k) => sums(&EDGE_ROWS[k as usize], &EDGE_VALUE_ROWS[k as usize]),
+        };
         std::array::from_fn(|l| {
             let v = |q: usize| DVec3::new(acc[q][0][l], acc[q][1][l], acc[q][2][l]);
             let (position, du, dv) = (v(0), v(1), v(2));
@@ -305,7 +339,8 @@ const ALL_ROWS: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9];
 
 /// A control net with every coordinate repeated in `L` lanes, `[control point][x, y, z][lane]`:
 /// the sums of [`accumulate`] are then the same operation on whole lanes, which compilers turn
-/// into SIMD arithmetic without being told.
+/// into SIMD arithmetic without being told. Made only for blocks of two or more lanes: a
+/// one-lane block reads the [`SoaNet`] itself (a level-2 run then makes no copy at all).
 type Broadcast<const L: usize> = [[[f64; L]; 3]; 10];
 
 fn broadcast<const L: usize>(net: &SoaNet) -> Broadcast<L> {
@@ -319,23 +354,77 @@ fn broadcast<const L: usize>(net: &SoaNet) -> Broadcast<L> {
     out
 }
 
+/// A net as the sums of `L` lanes read it: coordinate `c` of control point `m` in every lane.
+/// The same value whichever layout it comes from, so the sums have the same bits.
+trait LaneNet<const L: usize> {
+    fn lanes(&self, m: usize, c: usize) -> [f64; L];
+}
+
+impl<const L: usize> LaneNet<L> for Broadcast<L> {
+    #[inline(always)]
+    fn lanes(&self, m: usize, c: usize) -> [f64; L] {
+        self[m][c]
+    }
+}
+
+impl LaneNet<1> for SoaNet {
+    #[inline(always)]
+    fn lanes(&self, m: usize, c: usize) -> [f64; 1] {
+        [self[c][m]]
+    }
+}
+
 /// Adds the weighted sums of one net to `acc[quantity][coordinate][lane]`: for each lane, the
 /// control points in order, so that the result does not depend on how many lanes run together.
 ///
 /// The sums are taken and returned by value, and written as plain indexed loops: kept out of
 /// memory that way, the compiler unrolls them and runs the lanes in SIMD registers.
 #[inline(always)]
-fn accumulate<const L: usize, const R: usize>(
+#[allow(clippy::needless_range_loop)] // Indexed loops are the form that unrolls into SIMD.
+fn accumulate<const L: usize, const R: usize, N: LaneNet<L>>(
     w: &NetWeights<L>,
-    net: &Broadcast<L>,
+    net: &N,
     mut acc: [[[f64; L]; 3]; 3],
     rows: &[usize; R],
 ) -> [[[f64; L]; 3]; 3] {
     for &m in rows {
         for q in 0..3 {
             for c in 0..3 {
+                let x = net.lanes(m, c);
                 for l in 0..L {
-                    acc[q][c][l] += w[q][m][l] * net[m][c][l];
+                    acc[q][c][l] += w[q][m][l] * x[l];
+                }
+            }
+        }
+    }
+    acc
+}
+
+/// [`accumulate`] with the position summed over `value_rows` only and the tangents over `rows`
+/// (each in slot order; the sums are independent, so the split changes no bit).
+#[inline(always)]
+#[allow(clippy::needless_range_loop)] // As in `accumulate`.
+fn accumulate_split<const L: usize, const V: usize, const R: usize, N: LaneNet<L>>(
+    w: &NetWeights<L>,
+    net: &N,
+    mut acc: [[[f64; L]; 3]; 3],
+    value_rows: &[usize; V],
+    rows: &[usize; R],
+) -> [[[f64; L]; 3]; 3] {
+    for &m in value_rows {
+        for c in 0..3 {
+            let x = net.lanes(m, c);
+            for l in 0..L {
+                acc[0][c][l] += w[0][m][l] * x[l];
+            }
+        }
+    }
+    for &m in rows {
+        for q in 1..3 {
+            for c in 0..3 {
+                let x = net.lanes(m, c);
+                for l in 0..L {
+                    acc[q][c][l] += w[q][m][l] * x[l];
                 }
             }
         }
@@ -456,25 +545,22 @@ fn set_point(mesh: &TriMesh, tri: usize, patch: &mut Patch, slot: usize, value: 
     }
 }
 
-/// One patch set up for single points: its net broadcast once, and each neighbour's net
+/// One patch set up for single points: its net rebuilt once, and each neighbour's net
 /// composed (Eq. 3) the first time a point blends across that edge, then kept. A single point
 /// and a batch of them run the same arithmetic, so they agree bit for bit.
 struct PointEvaluation {
     tri: usize,
     widths: [f64; 3],
     local: Local,
-    own: Broadcast<1>,
-    across: [Option<Broadcast<1>>; 3],
+    across: [Option<SoaNet>; 3],
 }
 
 impl PointEvaluation {
     fn new(surface: &G2Surface, tri: usize) -> Self {
-        let (local, own) = surface.with_local(tri, |local| (*local, broadcast(&local.net)));
         PointEvaluation {
             tri,
             widths: surface.widths(tri),
-            own,
-            local,
+            local: surface.with_local(tri, |local| *local),
             across: [None; 3],
         }
     }
@@ -491,15 +577,14 @@ impl PointEvaluation {
         let tri = self.tri;
         let net = w.blended.then(|| {
             let k = w.k as usize;
-            &*self.across[k]
-                .get_or_insert_with(|| broadcast(&surface.across_net(tri, k, Reach::Whole)))
+            &*self.across[k].get_or_insert_with(|| surface.across_net(tri, k, Reach::Whole))
         });
         let [p] = G2Surface::combine(
             &self.local.normal,
             &Lanes::<1>::single(&w),
-            &self.own,
+            &self.local.net,
             net,
-            &ALL_ROWS,
+            EdgeRows::All,
         );
         p
     }
@@ -511,7 +596,7 @@ impl Surface for G2Surface<'_> {
         out.at(self, bary)
     }
 
-    /// [`Surface::evaluate`] point by point, with the own net broadcast and each neighbour's
+    /// [`Surface::evaluate`] point by point, with the own net rebuilt and each neighbour's
     /// net composed once for all of them instead of once per point.
     fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
         let mut points = PointEvaluation::new(self, tri);
@@ -529,7 +614,7 @@ impl Surface for G2Surface<'_> {
     }
 
     /// [`Surface::evaluate_lattice_part`] part after part, with the triangle's own net rebuilt
-    /// and broadcast once, and each neighbour's net composed (Eq. 3) once for every part that
+    /// once, and each neighbour's net composed (Eq. 3) once for every part that
     /// blends across its edge (an edge and the interior both do), instead of once per part;
     /// only its edge row when the parts are all edges.
     fn evaluate_lattice_parts(
@@ -545,7 +630,7 @@ impl Surface for G2Surface<'_> {
     }
 }
 
-/// One patch set up for lattice parts: its net rebuilt and broadcast once, and each
+/// One patch set up for lattice parts: its net rebuilt once, and each
 /// neighbour's net composed (Eq. 3) the first time a part blends across that edge, then kept.
 /// The values are those a part evaluated alone computes, so parts evaluated together or apart
 /// agree bit for bit.
@@ -554,26 +639,35 @@ struct PartEvaluation<'s, 'a> {
     tri: usize,
     widths: [f64; 3],
     local: Local,
-    own: Broadcast<LANES>,
+    /// The own net lane by lane, made when a block of two or more lanes first needs it.
+    own_lanes: Option<Broadcast<LANES>>,
     /// Each neighbour's composed net, and how much of it was composed.
-    across: [Option<(Reach, Broadcast<LANES>)>; 3],
+    across: [Option<Across>; 3],
     /// Whether every part asked for is an edge: then a neighbour's net is only ever weighed on
     /// its own edge, and its edge row is all that is composed ([`Reach::Edge`]).
     edges_only: bool,
+}
+
+/// A neighbour's net composed across one edge, for [`PartEvaluation`].
+struct Across {
+    /// How much of it was composed.
+    reach: Reach,
+    net: SoaNet,
+    /// `net` lane by lane, made when a block of two or more lanes first needs it.
+    lanes: Option<Broadcast<LANES>>,
 }
 
 impl<'s, 'a> PartEvaluation<'s, 'a> {
     /// The set-up for the lattice parts `parts` of triangle `tri`.
     #[inline]
     fn new(surface: &'s G2Surface<'a>, tri: usize, parts: &[(u32, LatticePart)]) -> Self {
-        let (local, own) = surface.with_local(tri, |local| (*local, broadcast(&local.net)));
         PartEvaluation {
             surface,
             tri,
             widths: surface.widths(tri),
-            own,
-            local,
-            across: [None; 3],
+            local: surface.with_local(tri, |local| *local),
+            own_lanes: None,
+            across: [None, None, None],
             edges_only: parts
                 .iter()
                 .all(|&(_, part)| matches!(part, LatticePart::Edge(_))),
@@ -588,7 +682,7 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
             tri,
             widths,
             local,
-            own,
+            own_lanes,
             across,
             edges_only,
         } = self;
@@ -610,13 +704,14 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                         normal: local.normal[c as usize],
                     };
                 }
-                let groups = std::iter::once((None, &pattern.plain))
-                    .chain((0..3).map(|k| (Some(k), &pattern.blended[k])));
-                for (k, blocks) in groups {
-                    if blocks.is_empty() {
+                // The plain points first, then those blended across each edge.
+                for group in [3, 0, 1, 2] {
+                    let (blocks, single) = pattern.group(group);
+                    if blocks.is_empty() && single.is_none() {
                         continue;
                     }
-                    let across = k.map(|k| {
+                    let k = (group < 3).then_some(group);
+                    if let Some(k) = k {
                         // Points of edge k blend only across edge k; any other part may weigh
                         // the whole net.
                         let reach = if *edges_only && part == LatticePart::Edge(k as u8) {
@@ -625,31 +720,47 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                             Reach::Whole
                         };
                         let cached = &mut across[k];
-                        if !matches!(*cached, Some((had, _)) if had == Reach::Whole || had == reach)
+                        if !matches!(cached, Some(had) if had.reach == Reach::Whole || had.reach == reach)
                         {
-                            let net = surface.across_net(*tri, k, reach);
-                            *cached = Some((reach, broadcast(&net)));
+                            *cached = Some(Across {
+                                reach,
+                                net: surface.across_net(*tri, k, reach),
+                                lanes: None,
+                            });
                         }
-                        &cached.as_ref().expect("composed just above").1
-                    });
-                    for lanes in blocks {
-                        let points = match pattern.edge_rows {
-                            Some(k) => G2Surface::combine(
+                    }
+                    if !blocks.is_empty() {
+                        let own = &*own_lanes.get_or_insert_with(|| broadcast(&local.net));
+                        let across = k.map(|k| {
+                            let a = across[k].as_mut().expect("composed just above");
+                            &*a.lanes.get_or_insert_with(|| broadcast(&a.net))
+                        });
+                        for lanes in blocks {
+                            let points = G2Surface::combine(
                                 &local.normal,
                                 lanes,
                                 own,
                                 across,
-                                &EDGE_ROWS[k as usize],
-                            ),
-                            None => {
-                                G2Surface::combine(&local.normal, lanes, own, across, &ALL_ROWS)
-                            }
-                        };
-                        for (&target, p) in lanes.target.iter().zip(points) {
-                            if target != Lanes::<1>::PADDING {
-                                out[target as usize] = p;
+                                pattern.edge_rows,
+                            );
+                            for (&target, p) in lanes.target.iter().zip(points) {
+                                if target != Lanes::<1>::PADDING {
+                                    out[target as usize] = p;
+                                }
                             }
                         }
+                    }
+                    if let Some(lane) = single {
+                        let across =
+                            k.map(|k| &across[k].as_ref().expect("composed just above").net);
+                        let [p] = G2Surface::combine(
+                            &local.normal,
+                            lane,
+                            &local.net,
+                            across,
+                            pattern.edge_rows,
+                        );
+                        out[lane.target[0] as usize] = p;
                     }
                 }
             });

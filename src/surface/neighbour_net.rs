@@ -21,7 +21,8 @@
 //!   factor `λ_k`), so their weights are `±0` and, by the argument above, the sums do not
 //!   depend on those control points at all: they are left at `0` and not composed.
 //!
-//! Cost (callgrind, one thread): about 430 instructions for an edge's seven points and 460
+//! Cost (callgrind, one thread): about 290 instructions for an edge's seven points (430 while
+//! they were laid out with the other differences and gathered, as a whole net's are) and 460
 //! for a whole net, where `compose` and the conversions to and from its layout took about 900;
 //! at level 2 every composition is an edge's, one per triangle's owned edge sample.
 
@@ -164,35 +165,96 @@ const SOURCE: [[[[u8; 10]; 3]; 3]; 3] = {
 /// net by `d` is.
 pub(super) fn compose_across(net_g: &SoaNet, k: usize, slots: [usize; 3], reach: Reach) -> SoaNet {
     match reach {
-        Reach::Whole => compose::<false>(net_g, k, slots),
-        Reach::Edge => compose::<true>(net_g, k, slots),
+        Reach::Whole => compose_whole(net_g, k, slots),
+        Reach::Edge => compose_edge(net_g, k, slots),
     }
 }
 
-/// [`compose_across`] with the reach fixed at compile time, so its tests fold away.
+/// An edge's composed points by where they come from: `(slot, neighbour slot)` for the four
+/// selections, `(slot, first difference)` for the three differences.
+type EdgeSources = ([(u8, u8); 4], [(u8, u8); 3]);
+
+/// `EDGE_SOURCE[k][p][q]`: for [`Reach::Edge`], the four composed slots with exponent 0 of
+/// `λ_k` and the neighbour slot each is (a selection), then the three with exponent 1 and the
+/// [`DEGREE2`] number of the first difference each is; both in slot order.
+const EDGE_SOURCE: [[[EdgeSources; 3]; 3]; 3] = {
+    let mut table = [[[([(0, 0); 4], [(0, 0); 3]); 3]; 3]; 3];
+    let mut k = 0;
+    while k < 3 {
+        let mut p = 0;
+        while p < 3 {
+            let mut q = 0;
+            while q < 3 {
+                let (mut selected, mut differences) = (0, 0);
+                let mut m = 0;
+                while p != q && m < 10 {
+                    let from = SOURCE[k][p][q][m];
+                    match IJK[m][k] {
+                        0 => {
+                            table[k][p][q].0[selected] = (m as u8, from);
+                            selected += 1;
+                        }
+                        1 => {
+                            table[k][p][q].1[differences] = (m as u8, from - 10);
+                            differences += 1;
+                        }
+                        _ => {}
+                    }
+                    m += 1;
+                }
+                assert!(p == q || (selected == 4 && differences == 3));
+                q += 1;
+            }
+            p += 1;
+        }
+        k += 1;
+    }
+    table
+};
+
+/// [`compose_across`] for [`Reach::Edge`]: the same values as [`compose`]'s for the seven
+/// points an edge weighs, written straight to their slots (four selections and three first
+/// differences, each summed as `compose` sums it), without laying out and gathering the
+/// differences an edge never reads; the other three points are left at 0.
 #[inline(always)]
-fn compose<const EDGE: bool>(net_g: &SoaNet, k: usize, slots: [usize; 3]) -> SoaNet {
+fn compose_edge(net_g: &SoaNet, k: usize, slots: [usize; 3]) -> SoaNet {
+    let [p, q, r] = slots;
+    let mut d = [1.0; 3];
+    d[r] = -1.0;
+    let (selected, differences) = &EDGE_SOURCE[k][p][q];
+    let mut out = [[0.0; 10]; 3];
+    for (g, out) in net_g.iter().zip(&mut out) {
+        for &(m, from) in selected {
+            out[m as usize] = g[from as usize];
+        }
+        for &(m, n) in differences {
+            let sum = &FIRST[n as usize];
+            out[m as usize] = d[0] * g[sum[0]] + d[1] * g[sum[1]] + d[2] * g[sum[2]];
+        }
+    }
+    out
+}
+
+/// [`compose_across`] for [`Reach::Whole`].
+#[inline(always)]
+fn compose_whole(net_g: &SoaNet, k: usize, slots: [usize; 3]) -> SoaNet {
     let [p, q, r] = slots;
     let mut d = [1.0; 3];
     d[r] = -1.0;
     let source = &SOURCE[k][p][q];
     let mut out = [[0.0; 10]; 3];
     for (g, out) in net_g.iter().zip(&mut out) {
-        // The neighbour's points, then the differences; those an edge does not read stay 0.
+        // The neighbour's points, then the differences.
         let mut values = [0.0; 20];
         values[..10].copy_from_slice(g);
         for (n, sum) in FIRST.iter().enumerate() {
-            if !EDGE || DEGREE2[n][r] == 0 {
-                values[10 + n] = d[0] * g[sum[0]] + d[1] * g[sum[1]] + d[2] * g[sum[2]];
-            }
+            values[10 + n] = d[0] * g[sum[0]] + d[1] * g[sum[1]] + d[2] * g[sum[2]];
         }
-        if !EDGE {
-            for (y, sum) in SECOND.iter().enumerate() {
-                let first = &values[10..16];
-                values[16 + y] = d[0] * first[sum[0]] + d[1] * first[sum[1]] + d[2] * first[sum[2]];
-            }
-            values[19] = d[0] * values[16] + d[1] * values[17] + d[2] * values[18];
+        for (y, sum) in SECOND.iter().enumerate() {
+            let first = &values[10..16];
+            values[16 + y] = d[0] * first[sum[0]] + d[1] * first[sum[1]] + d[2] * first[sum[2]];
         }
+        values[19] = d[0] * values[16] + d[1] * values[17] + d[2] * values[18];
         for (point, &from) in out.iter_mut().zip(source) {
             *point = values[from as usize];
         }
@@ -204,7 +266,7 @@ fn compose<const EDGE: bool>(net_g: &SoaNet, k: usize, slots: [usize; 3]) -> Soa
 mod tests {
     use super::*;
     use crate::surface::blend::neighbour_map;
-    use crate::surface::pattern::Pattern;
+    use crate::surface::pattern::{NetWeights, Pattern};
     use crate::surface::pn::{compose, Net};
     use crate::surface::{LatticePart, Profile};
     use glam::DVec3;
@@ -305,6 +367,14 @@ mod tests {
         }
     }
 
+    /// Whether the weights `across` are zero on every control point with exponent 2 or 3 of
+    /// `λ_k`.
+    fn off_row_zero<const L: usize>(across: &NetWeights<L>, k: usize) -> bool {
+        across
+            .iter()
+            .all(|quantity| (0..10).all(|m| IJK[m][k] < 2 || quantity[m].iter().all(|&w| w == 0.0)))
+    }
+
     /// What [`Reach::Edge`] rests on: on an edge part every neighbour weight of a control point
     /// with exponent 2 or 3 of the edge's `λ_k` is exactly zero.
     #[test]
@@ -314,16 +384,15 @@ mod tests {
                 for n in 2..=20 {
                     for k in 0..3u8 {
                         let pattern = Pattern::new(n, LatticePart::Edge(k), h, profile);
-                        for (group, blocks) in pattern.blended.iter().enumerate() {
-                            assert!(blocks.is_empty() || group == k as usize);
+                        for group in 0..3 {
+                            let (blocks, single) = pattern.group(group);
+                            let empty = blocks.is_empty() && single.is_none();
+                            assert!(empty || group == k as usize);
                             for lanes in blocks {
-                                for quantity in &lanes.across {
-                                    for (m, w) in quantity.iter().enumerate() {
-                                        if IJK[m][k as usize] >= 2 {
-                                            assert!(w.iter().all(|&w| w == 0.0), "{n} {k} {m}");
-                                        }
-                                    }
-                                }
+                                assert!(off_row_zero(&lanes.across, k as usize), "{n} {k}");
+                            }
+                            if let Some(lane) = single {
+                                assert!(off_row_zero(&lane.across, k as usize), "{n} {k}");
                             }
                         }
                     }

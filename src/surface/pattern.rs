@@ -90,6 +90,19 @@ impl<const L: usize> Lanes<L> {
     }
 }
 
+impl Lanes<1> {
+    /// Lane 0 of `lanes`, alone: the same weights, barycentrics and target.
+    fn first_of<const L: usize>(lanes: &Lanes<L>) -> Self {
+        let lane = |w: &NetWeights<L>| w.map(|quantity| quantity.map(|point| [point[0]]));
+        Lanes {
+            own: lane(&lanes.own),
+            across: lane(&lanes.across),
+            bary: [lanes.bary[0]],
+            target: [lanes.target[0]],
+        }
+    }
+}
+
 /// The geometry-free data of one domain point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointWeights {
@@ -153,33 +166,60 @@ pub struct Pattern {
     pub plain: Vec<Lanes<LANES>>,
     /// `blended[k]`: points that blend with the neighbour across the edge opposite corner `k`.
     pub blended: [Vec<Lanes<LANES>>; 3],
-    /// `Some(k)`: every weight of every block, on both nets, is exactly zero (`±0`) on the
-    /// three control points whose exponent of `λ_k` is 2 or 3, so the sums need only the other
-    /// seven ([`EDGE_ROWS`]`[k]`). So it is for every part on edge `k` (`λ_k = 0`: those
-    /// points' Bernstein values and derivatives all have a factor `λ_k`); it is found by
-    /// looking at the weights, never assumed, and `None` wherever one of them is not zero.
-    pub edge_rows: Option<u8>,
+    /// The last point of a group when it would fill only one lane of its block: `single[k]`
+    /// belongs with `blended[k]`, `single[3]` with `plain`. Summed one lane wide, it reads the
+    /// nets as they are, with no copy of them lane by lane, and with the same bits (each lane's
+    /// sums are its own); at level 2 every edge part is such a point, so no net is copied.
+    pub single: [Option<Lanes<1>>; 4],
+    /// Which control points the sums need ([`EdgeRows`]): found by looking at the weights,
+    /// never assumed, and [`EdgeRows::All`] wherever a weight left out would not be zero.
+    pub edge_rows: EdgeRows,
+}
+
+/// The control points whose weights a [`Pattern`]'s sums need, by what the pattern's weights
+/// are found to be exactly zero (`±0`) on, in every block and on both nets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EdgeRows {
+    /// All ten, for every quantity.
+    All,
+    /// The seven of [`EDGE_ROWS`]`[k]`: every weight is zero on the three control points whose
+    /// exponent of `λ_k` is 2 or 3. So it is for every part on edge `k` (`λ_k = 0`: those
+    /// points' Bernstein values and derivatives all have a factor `λ_k`).
+    Edge(u8),
+    /// As [`EdgeRows::Edge`], and the position's weights are also zero on the three points whose
+    /// exponent of `λ_k` is 1, so the position sums only the four of [`EDGE_VALUE_ROWS`]`[k]`,
+    /// edge `k`'s boundary curve (its Bernstein values, though not its derivatives, all have a
+    /// factor `λ_k` there too: Eq. 1 at `λ_k = 0`, and the blend of Eq. 5 keeps the factor).
+    EdgeValues(u8),
 }
 
 /// `EDGE_ROWS[k]`: the control points whose exponent of `λ_k` is 0 or 1, in slot order: all
-/// that a point on edge `k` weighs (see [`Pattern::edge_rows`]).
-pub const EDGE_ROWS: [[usize; 7]; 3] = {
-    let mut rows = [[0; 7]; 3];
+/// that a point on edge `k` weighs (see [`EdgeRows::Edge`]).
+pub const EDGE_ROWS: [[usize; 7]; 3] = rows_up_to::<7>(1);
+
+/// `EDGE_VALUE_ROWS[k]`: the control points whose exponent of `λ_k` is 0, in slot order: edge
+/// `k`'s boundary curve, all that the position of a point on edge `k` weighs (see
+/// [`EdgeRows::EdgeValues`]).
+pub const EDGE_VALUE_ROWS: [[usize; 4]; 3] = rows_up_to::<4>(0);
+
+/// For each `k`, the `N` control points whose exponent of `λ_k` is at most `most`, in slot order.
+const fn rows_up_to<const N: usize>(most: usize) -> [[usize; N]; 3] {
+    let mut rows = [[0; N]; 3];
     let mut k = 0;
     while k < 3 {
         let (mut m, mut n) = (0, 0);
         while m < 10 {
-            if IJK[m][k] <= 1 {
+            if IJK[m][k] <= most {
                 rows[k][n] = m;
                 n += 1;
             }
             m += 1;
         }
-        assert!(n == 7);
+        assert!(n == N);
         k += 1;
     }
     rows
-};
+}
 
 impl Pattern {
     /// Computes the pattern of `part` of the level-`n` lattice (`n ≥ 1`).
@@ -189,7 +229,8 @@ impl Pattern {
             corners: Vec::new(),
             plain: Vec::new(),
             blended: [Vec::new(), Vec::new(), Vec::new()],
-            edge_rows: None,
+            single: [None, None, None, None],
+            edge_rows: EdgeRows::All,
         };
         // Lanes filled so far in the last block of each group.
         let mut filled = [LANES; 4];
@@ -216,19 +257,48 @@ impl Pattern {
         }
         pattern.len = points.len();
         if let LatticePart::Edge(k) = part {
-            let zero_off_row = |w: &NetWeights<LANES>| {
-                w.iter().all(|quantity| {
-                    (0..10)
-                        .filter(|&m| IJK[m][k as usize] >= 2)
-                        .all(|m| quantity[m].iter().all(|&x| x == 0.0))
-                })
+            // Whether every weight of quantities `quantities` is zero on the control points
+            // whose exponent of `λ_k` is at least `from`, in every block, on both nets.
+            let zero_from = |from: usize, quantities: std::ops::Range<usize>| {
+                let zero = |w: &NetWeights<LANES>| {
+                    w[quantities.clone()].iter().all(|quantity| {
+                        (0..10)
+                            .filter(|&m| IJK[m][k as usize] >= from)
+                            .all(|m| quantity[m].iter().all(|&x| x == 0.0))
+                    })
+                };
+                let mut blocks = pattern.plain.iter().chain(pattern.blended.iter().flatten());
+                blocks.all(|lanes| zero(&lanes.own) && zero(&lanes.across))
             };
-            let mut blocks = pattern.plain.iter().chain(pattern.blended.iter().flatten());
-            if blocks.all(|lanes| zero_off_row(&lanes.own) && zero_off_row(&lanes.across)) {
-                pattern.edge_rows = Some(k);
+            if zero_from(2, 0..3) {
+                pattern.edge_rows = if zero_from(1, 0..1) {
+                    EdgeRows::EdgeValues(k)
+                } else {
+                    EdgeRows::Edge(k)
+                };
+            }
+        }
+        for (group, &filled) in filled.iter().enumerate() {
+            let blocks = match group {
+                3 => &mut pattern.plain,
+                k => &mut pattern.blended[k],
+            };
+            if filled == 1 {
+                let last = blocks.pop().expect("a block holds the point");
+                pattern.single[group] = Some(Lanes::first_of(&last));
             }
         }
         pattern
+    }
+
+    /// The blocks of group `group` (`k` < 3: blended across edge `k`, 3: plain) and its single
+    /// point, if any.
+    pub fn group(&self, group: usize) -> (&[Lanes<LANES>], Option<&Lanes<1>>) {
+        let blocks = match group {
+            3 => &self.plain,
+            k => &self.blended[k],
+        };
+        (blocks, self.single[group].as_ref())
     }
 }
 
@@ -288,9 +358,10 @@ mod tests {
     use super::*;
 
     /// What the edge parts' shortcut rests on, found in the weights themselves: every edge part
-    /// of every level, width and profile drops exactly the three control points off its rows
-    /// (so the fast sums are the ones taken at level 2, where every evaluated point is an
-    /// edge's), and no part with interior points drops any.
+    /// of every level, width and profile drops exactly the three control points off its rows,
+    /// and for the position the three next to them as well (so the fast sums are the ones taken
+    /// at level 2, where every evaluated point is an edge's), and no part with interior points
+    /// drops any.
     #[test]
     fn edge_parts_and_only_edge_parts_leave_out_the_points_off_their_rows() {
         for profile in [Profile::Paper, Profile::C2] {
@@ -298,10 +369,11 @@ mod tests {
                 for n in 2..=12 {
                     for k in 0..3u8 {
                         let edge = Pattern::new(n, LatticePart::Edge(k), h, profile);
-                        assert_eq!(edge.edge_rows, Some(k), "{n} {k} {h:?}");
+                        assert_eq!(edge.edge_rows, EdgeRows::EdgeValues(k), "{n} {k} {h:?}");
                     }
                     for part in [LatticePart::All, LatticePart::Interior] {
-                        assert_eq!(Pattern::new(n, part, h, profile).edge_rows, None);
+                        let rows = Pattern::new(n, part, h, profile).edge_rows;
+                        assert_eq!(rows, EdgeRows::All);
                     }
                 }
             }
