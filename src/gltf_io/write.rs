@@ -1104,6 +1104,23 @@ mod tests {
         assert_eq!(names.len(), 1, "{names:?}");
     }
 
+    /// The handle held on a replaced file keeps that file, unlinked, until it is let go: the
+    /// rename itself frees none of its blocks, whatever its size.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn the_replaced_file_is_held_across_the_rename() {
+        use std::os::unix::fs::MetadataExt as _;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.glb");
+        std::fs::write(&path, vec![7u8; 1 << 20]).unwrap();
+        let held = hold_replaced(&path).expect("a file to hold");
+        stage_bytes(&path, b"new").unwrap().persist(&path).unwrap();
+        let old = held.metadata().unwrap();
+        assert_eq!((old.len(), old.nlink()), (1 << 20, 0));
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert!(hold_replaced(&dir.path().join("none.glb")).is_none());
+    }
+
     /// What sits at the output's name is never opened for reading: a FIFO there (which an open
     /// for reading would wait on until a writer came) is replaced at once.
     #[cfg(target_os = "linux")]
