@@ -165,6 +165,12 @@ impl Pieces {
         self.pieces.iter().map(Piece::as_bytes)
     }
 
+    /// The pieces held in memory, in order, given up one by one: a writer frees each (and
+    /// the array it shares, once the document has let go of it) as soon as it is written.
+    pub fn into_pieces(self) -> impl Iterator<Item = Piece> {
+        self.pieces.into_iter()
+    }
+
     /// All pieces in one vector (all of them held in memory).
     pub fn concat(&self) -> Vec<u8> {
         assert_eq!(self.on_disk, 0, "concatenated bytes are held in memory");

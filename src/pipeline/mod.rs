@@ -107,7 +107,7 @@ fn stream_file(
     // renamed into place (the in-memory path in `process_file` checks at the same point).
     mesh_job::stop_if_cancelled(options, input)?;
     let finish_start = Instant::now();
-    let done = out.finish(&doc).map_err(at_output)?;
+    let done = out.finish(&mut doc).map_err(at_output)?;
     report.times.read = read_s;
     report.times.write += begin_s + finish_start.elapsed().as_secs_f64();
     report.times.total = started.elapsed().as_secs_f64();
