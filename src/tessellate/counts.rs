@@ -81,7 +81,16 @@ pub struct ChordErrors {
     /// rounding noise (a flat part probed in floating point has them) and count as 0, and no
     /// tolerance below it is sought, so a budget never refines a flat part for nothing.
     pub floor: f64,
+    /// The probe's second differences, `PROBE_STRIDE` values per source triangle as
+    /// `Curvature::keep` wrote them: stage 0 of
+    /// [`ChordErrors::refine_to_tolerance`] reads its checks from them instead of evaluating
+    /// the probe's lattice again (the same lattice, bit for bit).
+    probed: Vec<[f64; 3]>,
 }
+
+/// Values per source triangle in `ChordErrors::probed`: the probe lattice's interior points,
+/// then `Curvature::keep`'s trailer.
+const PROBE_STRIDE: usize = ((PROBE_LEVEL - 1) * (PROBE_LEVEL - 2) / 2) as usize + 1;
 
 /// Segment counts of one mesh: per welded edge and per source triangle's interior.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -97,7 +106,7 @@ impl ChordErrors {
     pub fn probe(mesh: &TriMesh, topo: &Topology, surface: &dyn Surface) -> ChordErrors {
         let p = PROBE_LEVEL;
         let scale = f64::from(p * p);
-        let per_tri: Vec<(f64, [f64; 3], f64)> = (0..mesh.triangles.len())
+        let per_tri: Vec<(f64, [f64; 3], f64, Vec<[f64; 3]>)> = (0..mesh.triangles.len())
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Curvature::default()),
@@ -110,10 +119,14 @@ impl ChordErrors {
                         .iter()
                         .map(|s| s.position.abs().max_element())
                         .fold(0.0, f64::max);
+                    let mut kept = Vec::with_capacity(PROBE_STRIDE);
+                    curvature.keep(&mut kept);
+                    debug_assert_eq!(kept.len(), PROBE_STRIDE);
                     (
                         finite(curvature.lattice_error(p) * scale),
                         edges.map(|d| finite(d * scale / 8.0)),
                         largest,
+                        kept,
                     )
                 },
             )
@@ -133,7 +146,15 @@ impl ChordErrors {
             edges: edges.into_iter().map(audible).collect(),
             rounding: finite(3f64.sqrt() * largest * 2f64.powi(-24)),
             floor,
+            probed: per_tri.iter().flat_map(|t| t.3.iter().copied()).collect(),
         }
+    }
+
+    /// The probe's second differences of source triangle `tri` (empty if not probed).
+    fn probed_at(&self, tri: usize) -> &[[f64; 3]] {
+        self.probed
+            .get(tri * PROBE_STRIDE..(tri + 1) * PROBE_STRIDE)
+            .unwrap_or(&[])
     }
 
     /// The counts that keep the chord error at or below `tolerance`, each at most `cap`.
@@ -187,7 +208,8 @@ impl ChordErrors {
     ///    resolution. Here the wave runs on the kept probe lattice; on a surface smooth at the
     ///    probe's scale its counts are those of stage 1, which then checks each triangle about
     ///    once (10k icosphere at the error level 16 reaches: the same counts and output bytes,
-    ///    11,100 lattices finer than the probe's evaluated instead of 23,828);
+    ///    11,100 lattices finer than the probe's evaluated instead of 23,828). Its checks read
+    ///    the probe's lattice as the probe kept it (`ChordErrors::probed`): it evaluates none;
     /// 1. predicted from the lattice at the pattern's own resolution (`estimate.rs`: one lattice
     ///    evaluation per triangle through the surface's cached weights, its second differences
     ///    along the normal), where the counts settle at a quarter of the points of
@@ -208,7 +230,7 @@ impl ChordErrors {
     /// The predictions check against the tolerance less the `f32` rounding of the written
     /// positions ([`ChordErrors::rounding`]), as they predict the error of the unrounded
     /// triangles; the measurement, which sees the rounding, against the tolerance itself. Stops
-    /// when every triangle meets it or is at `cap`.
+    /// when every triangle meets it or is at `cap`. `surface` is the one the probe read.
     pub fn refine_to_tolerance(
         &self,
         topo: &Topology,
@@ -239,7 +261,9 @@ impl ChordErrors {
                     let level = check_level(model.inner(), factor);
                     // The lattice depends on the triangle and the level alone: a triangle checked
                     // again with only its edge counts raised reads the second differences it kept.
-                    let read = !curvature.restore(level, kept);
+                    // Stage 0 reads, at its first check, the probe's own lattice.
+                    let read = !curvature.restore(level, kept)
+                        && !(factor == 0 && curvature.restore(level, self.probed_at(tri)));
                     if read {
                         points.clear();
                         surface.evaluate_lattice(tri, level, points);
