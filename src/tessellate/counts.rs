@@ -88,6 +88,10 @@ pub struct ChordErrors {
     probed: Vec<[f64; 3]>,
 }
 
+/// What the probe finds on one source triangle: its interior's and its edges' error constants,
+/// its largest coordinate, and its second differences as `Curvature::keep` writes them.
+type Probed = (f64, [f64; 3], f64, Vec<[f64; 3]>);
+
 /// Values per source triangle in `ChordErrors::probed`: the probe lattice's interior points,
 /// then `Curvature::keep`'s trailer.
 const PROBE_STRIDE: usize = ((PROBE_LEVEL - 1) * (PROBE_LEVEL - 2) / 2) as usize + 1;
@@ -106,7 +110,7 @@ impl ChordErrors {
     pub fn probe(mesh: &TriMesh, topo: &Topology, surface: &dyn Surface) -> ChordErrors {
         let p = PROBE_LEVEL;
         let scale = f64::from(p * p);
-        let per_tri: Vec<(f64, [f64; 3], f64, Vec<[f64; 3]>)> = (0..mesh.triangles.len())
+        let per_tri: Vec<Probed> = (0..mesh.triangles.len())
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Curvature::default()),
@@ -262,8 +266,9 @@ impl ChordErrors {
                     // The lattice depends on the triangle and the level alone: a triangle checked
                     // again with only its edge counts raised reads the second differences it kept.
                     // Stage 0 reads, at its first check, the probe's own lattice.
-                    let read = !curvature.restore(level, kept)
-                        && !(factor == 0 && curvature.restore(level, self.probed_at(tri)));
+                    let restored = curvature.restore(level, kept)
+                        || (factor == 0 && curvature.restore(level, self.probed_at(tri)));
+                    let read = !restored;
                     if read {
                         points.clear();
                         surface.evaluate_lattice(tri, level, points);
