@@ -380,7 +380,9 @@ impl PatternError {
 
 impl PatternModel {
     /// The model of `pattern` over the second differences of a level-`level` lattice (`level`
-    /// at least 3 and at least the pattern's inner level).
+    /// at least 3). A lattice coarser than the pattern's inner level, as the probe's, serves
+    /// too: its second differences, scaled by `L²`, are the same `D²S` (exactly on a quadratic
+    /// surface), read at fewer points, each the nearest to more of the pattern's corners.
     pub fn new(pattern: &Pattern, level: u32) -> PatternModel {
         let l2 = f64::from(level).powi(2);
         let mut edge_gains = [0.0f64; 3];
@@ -457,7 +459,7 @@ impl PatternModel {
     }
 
     /// The predicted errors of this pattern over the surface whose second differences are
-    /// `curvature` (a lattice of level at least the pattern's inner level).
+    /// `curvature` (the lattice the model was built for).
     pub fn error(&self, curvature: &mut Curvature) -> PatternError {
         let mut out = PatternError {
             inner: curvature.inner_error(self.key.inner),

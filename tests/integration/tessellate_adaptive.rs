@@ -483,3 +483,45 @@ fn no_lattice_finer_than_the_probe_is_evaluated_twice() {
     // moved after their first check there).
     assert!(rechecked > 0, "no triangle was checked twice");
 }
+
+#[test]
+fn the_counts_settle_on_the_probe_lattice() {
+    // The probe's edge constant (the edge curve's K/8) under-predicts what the ring triangles
+    // along an edge need (K/6 at the centroid of a triangle curved along its three edges), so
+    // every triangle fails its first check at its own resolution unless the counts have first
+    // settled on the probe's lattice with the same model. Then each triangle's lattice at its
+    // own resolution is read about once (exactly once here): 5,120-triangle icosphere at the
+    // error level 16 reaches (4.5e-6). Settling at the patterns' own resolution read about 2.4
+    // per triangle (the 10k icosphere: 23,828 lattices for 9,680 triangles, stage 2's
+    // included). Stage 2's lattices, at twice the inner level, are told apart by their level.
+    let mesh = icosphere(4);
+    let topo = Topology::build(&mesh);
+    let hs = h_all(&topo, 0.2);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let counting = CountingLattices {
+        inner: &surface,
+        lattices: Mutex::new(HashMap::new()),
+    };
+    let counts = ChordErrors::probe(&mesh, &topo, &surface)
+        .refine_to_tolerance(&topo, &counting, 4.5e-6, 64);
+    let lattices = counting.lattices.into_inner().unwrap();
+    let (lowest, highest) = (
+        *counts.inner.iter().min().unwrap(),
+        *counts.inner.iter().max().unwrap(),
+    );
+    assert!(
+        lowest > PROBE_LEVEL && 2 * lowest > highest,
+        "inner levels {lowest}..{highest}: stage 1 and 2 lattices overlap"
+    );
+    let own: usize = lattices
+        .iter()
+        .filter(|&(&(_, level), _)| level > PROBE_LEVEL && level <= highest)
+        .map(|(_, &n)| n as usize)
+        .sum();
+    let triangles = mesh.triangles.len();
+    println!("{own} lattices at the patterns' own resolution for {triangles} triangles");
+    assert!(
+        own <= triangles + triangles / 5,
+        "{own} lattices at the patterns' own resolution for {triangles} triangles"
+    );
+}
