@@ -96,6 +96,12 @@ type Probed = (f64, [f64; 3], f64, Vec<[f64; 3]>);
 /// then `Curvature::keep`'s trailer.
 const PROBE_STRIDE: usize = ((PROBE_LEVEL - 1) * (PROBE_LEVEL - 2) / 2) as usize + 1;
 
+/// The most memory the probe's kept lattice may take (about 96,000 triangles): beyond it stage 0
+/// evaluates the probe's lattice again. Kept whole it would take 696 bytes per triangle, more
+/// than the rest of an adaptive run holds per triangle (a 1M-triangle icosphere at 1e-3 peaked
+/// at 931 MB with it kept, 423 MB without).
+pub const PROBE_KEPT_BYTES: usize = 64 << 20;
+
 /// Segment counts of one mesh: per welded edge and per source triangle's interior.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct SegmentCounts {
@@ -106,8 +112,26 @@ pub struct SegmentCounts {
 }
 
 impl ChordErrors {
-    /// Probes `surface` once per triangle.
+    /// Probes `surface` once per triangle, keeping the probe's lattice for stage 0 of
+    /// [`ChordErrors::refine_to_tolerance`] when it fits in [`PROBE_KEPT_BYTES`].
     pub fn probe(mesh: &TriMesh, topo: &Topology, surface: &dyn Surface) -> ChordErrors {
+        ChordErrors::probe_keeping(mesh, topo, surface, PROBE_KEPT_BYTES)
+    }
+
+    /// [`ChordErrors::probe`], keeping the probe's lattice only when it takes at most
+    /// `kept_bytes` (696 bytes per triangle). Where it is not kept, stage 0 evaluates the same
+    /// lattice again, so the counts are the same either way: only time and memory differ.
+    pub fn probe_keeping(
+        mesh: &TriMesh,
+        topo: &Topology,
+        surface: &dyn Surface,
+        kept_bytes: usize,
+    ) -> ChordErrors {
+        let keep = mesh
+            .triangles
+            .len()
+            .checked_mul(PROBE_STRIDE * std::mem::size_of::<[f64; 3]>())
+            .is_some_and(|bytes| bytes <= kept_bytes);
         let p = PROBE_LEVEL;
         let scale = f64::from(p * p);
         let per_tri: Vec<Probed> = (0..mesh.triangles.len())
@@ -123,9 +147,11 @@ impl ChordErrors {
                         .iter()
                         .map(|s| s.position.abs().max_element())
                         .fold(0.0, f64::max);
-                    let mut kept = Vec::with_capacity(PROBE_STRIDE);
-                    curvature.keep(&mut kept);
-                    debug_assert_eq!(kept.len(), PROBE_STRIDE);
+                    let mut kept = Vec::new();
+                    if keep {
+                        curvature.keep(&mut kept);
+                        debug_assert_eq!(kept.len(), PROBE_STRIDE);
+                    }
                     (
                         finite(curvature.lattice_error(p) * scale),
                         edges.map(|d| finite(d * scale / 8.0)),

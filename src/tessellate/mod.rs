@@ -73,7 +73,7 @@ use std::ops::Range;
 
 pub use adaptive::tessellate_with_counts;
 pub use chord::chord_error;
-pub use counts::{ChordErrors, SegmentCounts, PROBE_LEVEL};
+pub use counts::{ChordErrors, SegmentCounts, PROBE_KEPT_BYTES, PROBE_LEVEL};
 
 /// Where an output vertex was sampled: a source triangle (index into the whole mesh) and a point
 /// of that triangle's level-n lattice. Attributes are interpolated from these.

@@ -10,7 +10,7 @@ use g2tess::mesh::TriMesh;
 use g2tess::surface::{G2Surface, LatticePart, Profile, Surface, SurfacePoint};
 use g2tess::tessellate::{
     chord_error, tessellate, tessellate_with_counts, ChordErrors, DenseMesh, SegmentCounts,
-    PROBE_LEVEL,
+    PROBE_KEPT_BYTES, PROBE_LEVEL,
 };
 use g2tess::topology::Topology;
 use glam::DVec3;
@@ -523,5 +523,45 @@ fn the_counts_settle_on_the_probe_lattice() {
     assert!(
         own <= triangles + triangles / 5,
         "{own} lattices at the patterns' own resolution for {triangles} triangles"
+    );
+}
+
+#[test]
+fn a_probe_too_large_to_keep_is_evaluated_again_to_the_same_counts() {
+    // The probe's lattice is kept for stage 0 only up to a memory bound; beyond it stage 0
+    // evaluates the same lattice again. Kept or not, the counts are the same; kept, no lattice
+    // at the probe's level is evaluated again (every inner level here is above it, so only
+    // stage 0 reads that level), and not kept, every triangle's is (its first stage-0 check).
+    let mesh = icosphere(4);
+    let topo = Topology::build(&mesh);
+    let hs = h_all(&topo, 0.2);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let mut results = Vec::new();
+    for kept_bytes in [PROBE_KEPT_BYTES, 0] {
+        let counting = CountingLattices {
+            inner: &surface,
+            lattices: Mutex::new(HashMap::new()),
+        };
+        let counts = ChordErrors::probe_keeping(&mesh, &topo, &surface, kept_bytes)
+            .refine_to_tolerance(&topo, &counting, 4.5e-6, 64);
+        assert!(*counts.inner.iter().min().unwrap() > PROBE_LEVEL);
+        let at_probe = counting
+            .lattices
+            .into_inner()
+            .unwrap()
+            .keys()
+            .filter(|&&(_, level)| level == PROBE_LEVEL)
+            .count();
+        results.push((counts, at_probe));
+    }
+    assert_eq!(
+        results[0].0, results[1].0,
+        "the counts depend on what was kept"
+    );
+    assert_eq!(results[0].1, 0, "a kept probe lattice was evaluated again");
+    assert_eq!(
+        results[1].1,
+        mesh.triangles.len(),
+        "not every triangle's probe lattice was evaluated again"
     );
 }
