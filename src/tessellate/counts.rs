@@ -23,6 +23,7 @@
 //!
 //! It deliberately writes no vertex.
 
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
@@ -509,27 +510,30 @@ impl SegmentCounts {
         let mut checked: Vec<Option<PatternKey>> = vec![None; self.inner.len()];
         // What each triangle's last check kept (empty: nothing).
         let mut kept: Vec<Vec<K>> = (0..self.inner.len()).map(|_| Vec::new()).collect();
+        // Every key built so far, for all rounds: as the counts settle the same few keys come
+        // back round after round (on the 10k icosphere at the error level 16 reaches, 502
+        // builds over the stages), and a build depends on its key alone.
+        let mut built: HashMap<PatternKey, P> = HashMap::new();
         loop {
             let keys: Vec<PatternKey> = (0..self.inner.len()).map(|t| self.key(topo, t)).collect();
             let mut distinct: Vec<PatternKey> = keys
                 .iter()
                 .zip(&checked)
-                .filter(|(k, c)| c.as_ref() != Some(k))
+                .filter(|(k, c)| c.as_ref() != Some(k) && !built.contains_key(k))
                 .map(|(k, _)| *k)
                 .collect();
             distinct.sort_unstable();
             distinct.dedup();
-            let built: Vec<P> = distinct.par_iter().map(|&k| build(k)).collect();
+            let fresh: Vec<P> = distinct.par_iter().map(|&k| build(k)).collect();
+            built.extend(distinct.into_iter().zip(fresh));
             // Per checked triangle, in order: its errors and what it kept, if anything.
             let results: Vec<(usize, PatternError, Vec<K>)> = (0..keys.len())
                 .into_par_iter()
                 .filter(|&t| checked[t].as_ref() != Some(&keys[t]))
                 .map_init(S::default, |scratch, t| {
-                    let p = distinct
-                        .binary_search(&keys[t])
-                        .expect("every key to check was built");
+                    let p = built.get(&keys[t]).expect("every key to check was built");
                     let mut keep = Vec::new();
-                    let error = check(t, &built[p], scratch, &kept[t], &mut keep);
+                    let error = check(t, p, scratch, &kept[t], &mut keep);
                     (t, error, keep)
                 })
                 .collect();

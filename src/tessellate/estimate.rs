@@ -253,8 +253,9 @@ impl Curvature {
     /// nearest its corners (found when the model was built), or any value at most `floor` when
     /// it is at most `floor` (its bound is then all it computes: the caller keeps a maximum
     /// that is at least `floor`).
-    fn sample_error(&self, s: &ModelSample, floor: f64) -> f64 {
-        let l2 = f64::from(self.level).powi(2);
+    /// `l2` is the lattice's `L²`, computed once per model by the caller.
+    #[inline(always)]
+    fn sample_error(&self, s: &ModelSample, floor: f64, l2: f64) -> f64 {
         let [d1, d2, d3] = self.at[s.point as usize];
         let mixed = d1 + d2 - d3;
         let q = s
@@ -353,7 +354,12 @@ struct ModelSample {
 pub(crate) struct PatternModel {
     key: PatternKey,
     level: u32,
+    /// Ordered by the edges they touch (bit mask), those touching one edge first.
     boundary: Vec<ModelSample>,
+    /// The runs of [`PatternModel::boundary`] with the same edges touched: the mask and the
+    /// end of its run. A run touching one edge keeps that edge's maximum in a register and
+    /// needs no per-sample test of the mask, which was about half of what a check cost.
+    runs: Vec<(u8, u32)>,
     /// Per edge, how much the predicted error of its triangles can grow per unit of
     /// [`Curvature::spread`]: each second difference `δ_k` off by at most `s` moves
     /// `Q_e = L²(ii δ₁ + jj δ₂ + ij (δ₁ + δ₂ − δ₃))` by at most
@@ -427,10 +433,22 @@ impl PatternModel {
             }
             same
         });
+        // The maxima do not depend on the order the samples are read in (see
+        // `PatternModel::error`): single edges first, so that the floors of the samples
+        // touching two edges are already those edges' largest single-edge errors.
+        boundary.sort_by_key(|s| (s.touches.count_ones(), s.touches));
+        let mut runs: Vec<(u8, u32)> = Vec::new();
+        for (i, s) in boundary.iter().enumerate() {
+            match runs.last_mut() {
+                Some((mask, end)) if *mask == s.touches => *end = i as u32 + 1,
+                _ => runs.push((s.touches, i as u32 + 1)),
+            }
+        }
         PatternModel {
             key: pattern.key,
             level,
             boundary,
+            runs,
             edge_gains,
         }
     }
@@ -469,20 +487,39 @@ impl PatternModel {
             curvature.level, self.level,
             "the model was built for this lattice"
         );
-        for t in &self.boundary {
-            // The smallest maximum this sample could raise.
-            let touched = |k: usize| {
-                if t.touches & (1 << k) != 0 {
-                    out.edges[k]
-                } else {
-                    f64::INFINITY
+        // Each edge's error is the largest over the samples touching it, whatever their order
+        // (`larger` skips NaN as a maximum does), and a sample skipped by its bound is at most
+        // the floor, the smallest maximum it could raise: so reading the samples run by run
+        // gives the plain maximum bit for bit.
+        let l2 = f64::from(self.level).powi(2);
+        let mut start = 0;
+        for &(mask, end) in &self.runs {
+            let run = &self.boundary[start..end as usize];
+            start = end as usize;
+            if mask.count_ones() == 1 {
+                let k = mask.trailing_zeros() as usize;
+                let mut worst = out.edges[k];
+                for t in run {
+                    worst = larger(worst, curvature.sample_error(t, worst, l2));
                 }
-            };
-            let floor = touched(0).min(touched(1)).min(touched(2));
-            let e = curvature.sample_error(t, floor);
-            for (k, edge) in out.edges.iter_mut().enumerate() {
-                if t.touches & (1 << k) != 0 {
-                    *edge = larger(*edge, e);
+                out.edges[k] = worst;
+                continue;
+            }
+            for t in run {
+                // The smallest maximum this sample could raise.
+                let touched = |k: usize| {
+                    if mask & (1 << k) != 0 {
+                        out.edges[k]
+                    } else {
+                        f64::INFINITY
+                    }
+                };
+                let floor = touched(0).min(touched(1)).min(touched(2));
+                let e = curvature.sample_error(t, floor, l2);
+                for (k, edge) in out.edges.iter_mut().enumerate() {
+                    if mask & (1 << k) != 0 {
+                        *edge = larger(*edge, e);
+                    }
                 }
             }
         }
