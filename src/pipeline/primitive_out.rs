@@ -9,7 +9,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::morph::TargetSurface;
-use crate::attributes::{self, Carry, FloatAttribute, Skin, SourceTriangles};
+use crate::attributes::{self, Carry, Skin, SourceTriangles};
 use crate::gltf_io::semantic::{self, NORMAL, POSITION, TANGENT};
 use crate::gltf_io::{Attribute, PrimitiveData, Values};
 use crate::normals::GeneratedNormals;
@@ -313,12 +313,8 @@ fn carry_one(a: &Attribute, tris: SourceTriangles<'_>, dense: &DenseMesh) -> Att
             } else {
                 Carry::Interpolate
             };
-            let source = FloatAttribute {
-                components: a.components,
-                values: v.clone(),
-            };
-            let carried = attributes::carry(&source, rule, tris, &dense.sources);
-            float_attribute(&a.name, a.components, carried.values)
+            let carried = attributes::carry_values(v, a.components, rule, tris, &dense.sources);
+            float_attribute(&a.name, a.components, carried)
         }
     }
 }
