@@ -18,7 +18,7 @@ use crate::mesh::TriMesh;
 use crate::topology::{EdgeId, EdgeKind, Topology, TriId};
 
 mod connectivity;
-use connectivity::{bow_tie_vertices, pieces};
+use connectivity::{around_vertices, bow_tie_vertices, pieces};
 
 /// Triangles whose smallest angle is below this (in radians, about 0.06°) are slivers: valid,
 /// but their normals and parameterization are numerically fragile.
@@ -32,6 +32,34 @@ const EXAMPLES: usize = 3;
 /// One warning per odd kind of geometry found in `mesh` (the joined triangle primitives of mesh
 /// `index`), each naming the fallback applied.
 pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warning> {
+    // The search for pieces and the tally of each vertex's triangles are each one pass on one
+    // thread: they run beside the parallel passes over the triangles and the edges, which the
+    // other threads share out (and this one joins once they are done), instead of after them
+    // with the other threads idle.
+    let ((pieces, around), mut out) = rayon::join(
+        || (pieces(topo), around_vertices(topo)),
+        || parallel_warnings(index, mesh, topo),
+    );
+    let bow_ties = bow_tie_vertices(topo, around);
+    if bow_ties.count > 0 {
+        out.push(Warning::BowTieVertices {
+            mesh: index,
+            count: bow_ties.count,
+            vertices: bow_ties.examples().to_vec(),
+        });
+    }
+    if pieces > MANY_PIECES {
+        out.push(Warning::ManyPieces {
+            mesh: index,
+            pieces,
+        });
+    }
+    out
+}
+
+/// The warnings of [`mesh_warnings`] found by parallel passes over the triangles and the
+/// edges, in the order they are reported.
+fn parallel_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warning> {
     let mut out = Vec::new();
     // One parallel pass over the triangles for every per-triangle test, which also marks the
     // vertices their corners use (every store writes `true`, so the order the threads run in
@@ -130,22 +158,6 @@ pub fn mesh_warnings(index: usize, mesh: &TriMesh, topo: &Topology) -> Vec<Warni
         });
     }
 
-    let bow_ties = bow_tie_vertices(topo);
-    if bow_ties.count > 0 {
-        out.push(Warning::BowTieVertices {
-            mesh: index,
-            count: bow_ties.count,
-            vertices: bow_ties.examples().to_vec(),
-        });
-    }
-
-    let pieces = pieces(topo);
-    if pieces > MANY_PIECES {
-        out.push(Warning::ManyPieces {
-            mesh: index,
-            pieces,
-        });
-    }
     out
 }
 
@@ -429,7 +441,7 @@ mod tests {
             let mesh = odd_mesh(seed, 8 + 5 * seed as usize);
             let topo = Topology::build(&mesh);
             let want = bow_ties_by_search(&topo);
-            let got = bow_tie_vertices(&topo);
+            let got = bow_tie_vertices(&topo, around_vertices(&topo));
             assert_eq!(got.count, want.len(), "seed {seed}");
             assert_eq!(got.examples(), &want[..want.len().min(EXAMPLES)]);
 
@@ -505,11 +517,72 @@ mod tests {
                     .num_threads(threads)
                     .build()
                     .unwrap()
-                    .install(|| (bow_tie_vertices(&topo), pieces(&topo)));
+                    .install(|| {
+                        (
+                            bow_tie_vertices(&topo, around_vertices(&topo)),
+                            pieces(&topo),
+                        )
+                    });
                 assert_eq!(got.count, want.len(), "seed {seed}, {threads} threads");
                 assert_eq!(got.examples(), &want[..want.len().min(EXAMPLES)]);
                 assert_eq!(pieces_got, pieces_want, "seed {seed}, {threads} threads");
             }
+        }
+    }
+
+    /// The searches that run beside the parallel passes change neither the warnings nor their
+    /// order: a mesh of more than [`MANY_PIECES`] pieces (copies of two triangles sharing one
+    /// vertex, a bow-tie each, some wound against the other, with boundary edges and unused
+    /// vertices) gives the same list on every thread count, the bow-ties and the pieces last,
+    /// as they were reported when they ran after the other checks.
+    #[test]
+    fn warnings_keep_their_order_with_the_searches_beside_the_passes() {
+        let mut mesh = TriMesh::default();
+        for i in 0..1200u32 {
+            let o = DVec3::new(f64::from(i) * 10.0, 0.0, 0.0);
+            mesh.positions.extend(
+                [
+                    (0.0, 0.0),
+                    (1.0, 0.0),
+                    (0.0, 1.0),
+                    (-1.0, 0.0),
+                    (0.0, -1.0),
+                    (5.0, 5.0),
+                ]
+                .map(|(x, y)| o + DVec3::new(x, y, 0.0)),
+            );
+            let b = 6 * i;
+            mesh.triangles.push([b, b + 1, b + 2]);
+            if i % 2 == 0 {
+                mesh.triangles.push([b, b + 3, b + 4]);
+            } else {
+                mesh.triangles.push([b, b + 4, b + 3]);
+            }
+        }
+        mesh.normals = vec![DVec3::Z; mesh.positions.len()];
+        let topo = Topology::build(&mesh);
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| mesh_warnings(0, &mesh, &topo))
+        };
+        let one = on(1);
+        let kinds: Vec<&str> = one
+            .iter()
+            .map(|w| match w {
+                Warning::UnusedVertices { .. } => "unused",
+                Warning::NormalsFacingAway { .. } => "away",
+                Warning::BoundaryEdges { .. } => "boundary",
+                Warning::BowTieVertices { count: 1200, .. } => "bow-ties",
+                Warning::ManyPieces { pieces: 2400, .. } => "pieces",
+                _ => "other",
+            })
+            .collect();
+        assert_eq!(kinds, ["unused", "away", "boundary", "bow-ties", "pieces"]);
+        for threads in [2, 3] {
+            assert_eq!(on(threads), one, "{threads} threads");
         }
     }
 
@@ -652,7 +725,12 @@ mod tests {
                     .num_threads(threads)
                     .build()
                     .unwrap()
-                    .install(|| (bow_tie_vertices(&topo), pieces(&topo)));
+                    .install(|| {
+                        (
+                            bow_tie_vertices(&topo, around_vertices(&topo)),
+                            pieces(&topo),
+                        )
+                    });
                 assert_eq!(got.count, want.len(), "{name}, {threads} threads");
                 assert_eq!(got.examples(), &want[..want.len().min(EXAMPLES)], "{name}");
                 assert_eq!(pieces_got, pieces_want, "{name}, {threads} threads");

@@ -22,7 +22,7 @@ const BLOCK: usize = 4096;
 /// triangle with two corners at it counted once) and the last corner (`3 × triangle + slot`)
 /// that does.
 #[derive(Debug, Clone, Copy, Default)]
-struct Around {
+pub(super) struct Around {
     triangles: u32,
     corner: u32,
 }
@@ -40,8 +40,8 @@ struct Around {
 /// (see [`walk_fan`]). Linear in the corners, whatever the valence; the vertices are decided in
 /// parallel, in blocks tallied in vertex order. A walk that meets a non-manifold or degenerate
 /// edge leaves its vertex to [`bow_ties_by_corners`].
-pub(super) fn bow_tie_vertices(topo: &Topology) -> Tally {
-    let around = around_vertices(topo);
+/// `around` is [`around_vertices`] of `topo`, taken by the caller (beside other work).
+pub(super) fn bow_tie_vertices(topo: &Topology, around: Vec<Around>) -> Tally {
     let blocks = around.len().div_ceil(BLOCK);
     let (mut found, undecided) = (0..blocks)
         .into_par_iter()
@@ -84,7 +84,7 @@ pub(super) fn bow_tie_vertices(topo: &Topology) -> Tally {
 }
 
 /// Per welded vertex, its triangle count and one of its corners: one pass over the corners.
-fn around_vertices(topo: &Topology) -> Vec<Around> {
+pub(super) fn around_vertices(topo: &Topology) -> Vec<Around> {
     let mut around = vec![Around::default(); topo.welded_positions.len()];
     for (t, v) in topo.tri_verts.iter().enumerate() {
         let firsts = [true, v[1] != v[0], v[2] != v[0] && v[2] != v[1]];
