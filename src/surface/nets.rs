@@ -108,10 +108,40 @@ pub fn circle_handle(p: DVec3, n: DVec3, q: DVec3, nq: DVec3) -> DVec3 {
     if c2 == 0.0 {
         return p;
     }
+    handle_along(p, n, chord, c2, n + nq)
+}
+
+/// Both handles of the circle cubic between `(p, n)` and `(q, nq)`:
+/// `[circle_handle(p, n, q, nq), circle_handle(q, nq, p, n)]`, bit for bit.
+///
+/// Every net rule asks for an edge's two handles together (the round net's three edges, the
+/// side-vertex rule's three spokes), and the two calls share what does not depend on the end:
+/// the squared chord length (`p − q` is `−(q − p)` but for the sign of zeros, whose squares are
+/// the same `+0`, summed in the same order) and the edge plane's mean normal (`n + nq` and
+/// `nq + n` are the same sum: addition commutes exactly). Computing them once leaves every
+/// operation of each handle as it was.
+#[inline]
+pub fn circle_handles(p: DVec3, n: DVec3, q: DVec3, nq: DVec3) -> [DVec3; 2] {
+    let chord = q - p;
+    let c2 = chord.length_squared();
+    if c2 == 0.0 {
+        return [p, q];
+    }
+    let mean = n + nq;
+    [
+        handle_along(p, n, chord, c2, mean),
+        handle_along(q, nq, p - q, c2, mean),
+    ]
+}
+
+/// [`circle_handle`] at `p` (unit normal `n`) for the chord `chord` to the other end, its
+/// squared length `c2 > 0` and the mean normal `mean` of the two ends (not normalized).
+#[inline(always)]
+fn handle_along(p: DVec3, n: DVec3, chord: DVec3, c2: f64, mean: DVec3) -> DVec3 {
     // The tangent line: across the edge plane's normal m; t(t·chord)/|t|² does not depend on
     // t's sign or length. Where the plane is undefined (the chord along the mean normal, or
     // the plane parallel to the tangent plane), PN's projection into the tangent plane.
-    let m = chord.cross(n + nq);
+    let m = chord.cross(mean);
     let t = m.cross(n);
     let t2 = t.length_squared();
     let tangent = if t2 > 1e-20 * c2 {
@@ -128,9 +158,9 @@ pub fn round_net(p: [DVec3; 3], n: [DVec3; 3]) -> Net {
     let mut net = [DVec3::ZERO; 10];
     for c in 0..3 {
         net[NEAR[c][c]] = p[c];
-        for e in (0..3).filter(|&e| e != c) {
-            net[NEAR[c][e]] = circle_handle(p[c], n[c], p[e], n[e]);
-        }
+        // Each edge's two handles at once (see `circle_handles`).
+        let e = (c + 1) % 3;
+        [net[NEAR[c][e]], net[NEAR[e][c]]] = circle_handles(p[c], n[c], p[e], n[e]);
     }
     net[B111] = side_vertex_centre(&net, n);
     net
@@ -151,8 +181,7 @@ pub fn side_vertex_centre(net: &Net, n: [DVec3; 3]) -> DVec3 {
         let (j, k) = ((i + 1) % 3, (i + 2) % 3);
         let mid = (net[j] + 3.0 * net[NEAR[j][k]] + 3.0 * net[NEAR[k][j]] + net[k]) / 8.0;
         let n_mid = (n[j] + n[k]).normalize_or(n[i]);
-        let a = circle_handle(net[i], n[i], mid, n_mid);
-        let b = circle_handle(mid, n_mid, net[i], n[i]);
+        let [a, b] = circle_handles(net[i], n[i], mid, n_mid);
         // The cubic (p_i, a, b, M) at t = 2/3: Bernstein weights 1, 6, 12, 8 over 27.
         x += (net[i] + 6.0 * a + 12.0 * b + 8.0 * mid) / 27.0;
     }
@@ -237,6 +266,59 @@ mod tests {
         assert!((b - DVec3::X / 3.0).length() < 1e-15, "{b}");
         let steep = circle_handle(DVec3::ZERO, up, DVec3::new(0.1, 0.0, 1.0), -up);
         assert!(steep.is_finite() && steep.length() < 1.01, "{steep}");
+    }
+
+    /// What lets the net rules take an edge's two handles at once: the pair is the two single
+    /// handles bit for bit, on random edges and on the cases where a shared term could differ in
+    /// sign or branch: chords with zero components (of either sign of the ends' coordinates),
+    /// coincident ends, chords along the normals, and opposite normals.
+    #[test]
+    fn an_edges_two_handles_together_are_the_single_handles_bit_for_bit() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut cases = Vec::new();
+        for i in 0..2000 {
+            let mut p = DVec3::new(next(), next(), next());
+            let mut q = p + 0.3 * DVec3::new(next(), next(), next());
+            let n = DVec3::new(next(), next(), next()).normalize();
+            let mut nq = (n + 0.5 * DVec3::new(next(), next(), next())).normalize();
+            match i % 6 {
+                // Equal coordinates, zero of either sign: chord components of +0.
+                1 => {
+                    p.x = if i % 12 == 1 { -0.0 } else { 0.0 };
+                    q.x = p.x;
+                    q.y = p.y;
+                }
+                2 => q = p,
+                3 => q = p + 0.2 * n,
+                4 => nq = -n,
+                5 => {
+                    p = DVec3::new(-0.0, 0.0, -0.0);
+                    q.z = -0.0;
+                }
+                _ => {}
+            }
+            cases.push((p, n, q, nq));
+        }
+        let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+        for (p, n, q, nq) in cases {
+            let [a, b] = circle_handles(p, n, q, nq);
+            assert_eq!(
+                bits(a),
+                bits(circle_handle(p, n, q, nq)),
+                "{p} {n} {q} {nq}"
+            );
+            assert_eq!(
+                bits(b),
+                bits(circle_handle(q, nq, p, n)),
+                "{p} {n} {q} {nq}"
+            );
+        }
     }
 
     #[test]
