@@ -218,7 +218,10 @@ impl<'a> G2Surface<'a> {
     /// and composing costs less than the page faults of holding them. Each is composed once per
     /// lattice part, with the same arithmetic on every path, so point and lattice evaluation
     /// still agree bit for bit.
-    fn across_net(&self, tri: usize, k: usize, reach: Reach) -> SoaNet {
+    ///
+    /// Written into `out` (see [`compose_across`]): a part composes straight into the net it
+    /// keeps.
+    fn across_net(&self, tri: usize, k: usize, reach: Reach, out: &mut SoaNet) {
         debug_assert!(self.widths(tri)[k] > 0.0, "only blended edges");
         let n = self
             .topo
@@ -232,7 +235,7 @@ impl<'a> G2Surface<'a> {
         // into their tangent plane or not (each point's projection reads only itself, its
         // corner and that corner's normal), so the composed net has the same bits either way.
         self.with_local(n.tri.0 as usize, |g| {
-            compose_across(&g.net, k, [p, q, r], reach)
+            compose_across(&g.net, k, [p, q, r], reach, out)
         })
     }
 
@@ -577,7 +580,11 @@ impl PointEvaluation {
         let tri = self.tri;
         let net = w.blended.then(|| {
             let k = w.k as usize;
-            &*self.across[k].get_or_insert_with(|| surface.across_net(tri, k, Reach::Whole))
+            &*self.across[k].get_or_insert_with(|| {
+                let mut net = [[0.0; 10]; 3];
+                surface.across_net(tri, k, Reach::Whole, &mut net);
+                net
+            })
         });
         let [p] = G2Surface::combine(
             &self.local.normal,
@@ -610,7 +617,7 @@ impl Surface for G2Surface<'_> {
         part: LatticePart,
         out: &mut Vec<SurfacePoint>,
     ) {
-        PartEvaluation::new(self, tri, &[(level, part)]).part(level, part, out);
+        PartEvaluation::run(self, tri, &[(level, part)], out);
     }
 
     /// [`Surface::evaluate_lattice_part`] part after part, with the triangle's own net rebuilt
@@ -623,10 +630,7 @@ impl Surface for G2Surface<'_> {
         parts: &[(u32, LatticePart)],
         out: &mut Vec<SurfacePoint>,
     ) {
-        let mut evaluation = PartEvaluation::new(self, tri, parts);
-        for &(level, part) in parts {
-            evaluation.part(level, part, out);
-        }
+        PartEvaluation::run(self, tri, parts, out);
     }
 }
 
@@ -658,19 +662,36 @@ struct Across {
 }
 
 impl<'s, 'a> PartEvaluation<'s, 'a> {
-    /// The set-up for the lattice parts `parts` of triangle `tri`.
+    /// The points of the lattice parts `parts` of triangle `tri`, in order, appended to `out`.
+    ///
+    /// The set-up is made here and used where it is made: returned from a constructor, it was
+    /// moved twice on the way (about 3 kB with the room for its lane copies and neighbour nets,
+    /// twice per triangle), and its own net was copied out of the memo through a return value
+    /// as well; it is now copied once, straight into place.
     #[inline]
-    fn new(surface: &'s G2Surface<'a>, tri: usize, parts: &[(u32, LatticePart)]) -> Self {
-        PartEvaluation {
+    fn run(
+        surface: &'s G2Surface<'a>,
+        tri: usize,
+        parts: &[(u32, LatticePart)],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let mut evaluation = PartEvaluation {
             surface,
             tri,
             widths: surface.widths(tri),
-            local: surface.with_local(tri, |local| *local),
+            local: Local {
+                net: [[0.0; 10]; 3],
+                normal: [DVec3::ZERO; 3],
+            },
             own_lanes: None,
             across: [None, None, None],
             edges_only: parts
                 .iter()
                 .all(|&(_, part)| matches!(part, LatticePart::Edge(_))),
+        };
+        surface.with_local(tri, |local| evaluation.local = *local);
+        for &(level, part) in parts {
+            evaluation.part(level, part, out);
         }
     }
 
@@ -722,11 +743,12 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                         let cached = &mut across[k];
                         if !matches!(cached, Some(had) if had.reach == Reach::Whole || had.reach == reach)
                         {
-                            *cached = Some(Across {
+                            let kept = cached.insert(Across {
                                 reach,
-                                net: surface.across_net(*tri, k, reach),
+                                net: [[0.0; 10]; 3],
                                 lanes: None,
                             });
+                            surface.across_net(*tri, k, reach, &mut kept.net);
                         }
                     }
                     if !blocks.is_empty() {

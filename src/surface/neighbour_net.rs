@@ -163,10 +163,21 @@ const SOURCE: [[[[u8; 10]; 3]; 3]; 3] = {
 /// `a_i·e_p + a_j·e_q`, each difference `Σ_c d_c·v(· + e_c)` summed in the order `compose` sums
 /// it (`c` = 0, 1, 2). The first differences are shared by all slots, as `compose`'s quadratic
 /// net by `d` is.
-pub(super) fn compose_across(net_g: &SoaNet, k: usize, slots: [usize; 3], reach: Reach) -> SoaNet {
+///
+/// Written into `out`, every point of it (those `reach` leaves out set to 0), so that the
+/// surface composes straight into the net it keeps rather than into one it then copies (240
+/// bytes per composition, one composition per evaluated edge at level 2).
+#[inline]
+pub(super) fn compose_across(
+    net_g: &SoaNet,
+    k: usize,
+    slots: [usize; 3],
+    reach: Reach,
+    out: &mut SoaNet,
+) {
     match reach {
-        Reach::Whole => compose_whole(net_g, k, slots),
-        Reach::Edge => compose_edge(net_g, k, slots),
+        Reach::Whole => compose_whole(net_g, k, slots, out),
+        Reach::Edge => compose_edge(net_g, k, slots, out),
     }
 }
 
@@ -217,13 +228,15 @@ const EDGE_SOURCE: [[[EdgeSources; 3]; 3]; 3] = {
 /// differences, each summed as `compose` sums it), without laying out and gathering the
 /// differences an edge never reads; the other three points are left at 0.
 #[inline(always)]
-fn compose_edge(net_g: &SoaNet, k: usize, slots: [usize; 3]) -> SoaNet {
+fn compose_edge(net_g: &SoaNet, k: usize, slots: [usize; 3], out: &mut SoaNet) {
     let [p, q, r] = slots;
     let mut d = [1.0; 3];
     d[r] = -1.0;
     let (selected, differences) = &EDGE_SOURCE[k][p][q];
-    let mut out = [[0.0; 10]; 3];
-    for (g, out) in net_g.iter().zip(&mut out) {
+    for (g, out) in net_g.iter().zip(out) {
+        for &m in &OFF_EDGE[k] {
+            out[m as usize] = 0.0;
+        }
         for &(m, from) in selected {
             out[m as usize] = g[from as usize];
         }
@@ -232,18 +245,36 @@ fn compose_edge(net_g: &SoaNet, k: usize, slots: [usize; 3]) -> SoaNet {
             out[m as usize] = d[0] * g[sum[0]] + d[1] * g[sum[1]] + d[2] * g[sum[2]];
         }
     }
-    out
 }
+
+/// `OFF_EDGE[k]`: the three slots whose exponent of `λ_k` is 2 or 3, which [`Reach::Edge`]
+/// leaves at 0.
+const OFF_EDGE: [[u8; 3]; 3] = {
+    let mut table = [[0; 3]; 3];
+    let mut k = 0;
+    while k < 3 {
+        let (mut m, mut n) = (0, 0);
+        while m < 10 {
+            if IJK[m][k] >= 2 {
+                table[k][n] = m as u8;
+                n += 1;
+            }
+            m += 1;
+        }
+        assert!(n == 3);
+        k += 1;
+    }
+    table
+};
 
 /// [`compose_across`] for [`Reach::Whole`].
 #[inline(always)]
-fn compose_whole(net_g: &SoaNet, k: usize, slots: [usize; 3]) -> SoaNet {
+fn compose_whole(net_g: &SoaNet, k: usize, slots: [usize; 3], out: &mut SoaNet) {
     let [p, q, r] = slots;
     let mut d = [1.0; 3];
     d[r] = -1.0;
     let source = &SOURCE[k][p][q];
-    let mut out = [[0.0; 10]; 3];
-    for (g, out) in net_g.iter().zip(&mut out) {
+    for (g, out) in net_g.iter().zip(out) {
         // The neighbour's points, then the differences.
         let mut values = [0.0; 20];
         values[..10].copy_from_slice(g);
@@ -259,7 +290,6 @@ fn compose_whole(net_g: &SoaNet, k: usize, slots: [usize; 3]) -> SoaNet {
             *point = values[from as usize];
         }
     }
-    out
 }
 
 #[cfg(test)]
@@ -297,6 +327,13 @@ mod tests {
         [0, 1, 2].map(|c| net.map(|p| p[c]))
     }
 
+    /// [`compose_across`] into a net of NaNs: a point it did not write would show.
+    fn composed(net_g: &SoaNet, k: usize, slots: [usize; 3], reach: Reach) -> SoaNet {
+        let mut out = [[f64::NAN; 10]; 3];
+        compose_across(net_g, k, slots, reach, &mut out);
+        out
+    }
+
     /// Same value, and the same bits wherever the value is not zero.
     fn same(a: f64, b: f64) -> bool {
         a == b && (a == 0.0 || a.to_bits() == b.to_bits())
@@ -316,8 +353,8 @@ mod tests {
             for k in 0..3 {
                 for slots in slot_orders {
                     let want = compose(&net, neighbour_map(k, slots));
-                    let got = compose_across(&by_coordinate(&net), k, slots, Reach::Whole);
-                    let edge = compose_across(&by_coordinate(&net), k, slots, Reach::Edge);
+                    let got = composed(&by_coordinate(&net), k, slots, Reach::Whole);
+                    let edge = composed(&by_coordinate(&net), k, slots, Reach::Edge);
                     for (m, exponents) in IJK.iter().enumerate() {
                         for x in 0..3 {
                             assert!(same(got[x][m], want[m][x]), "k {k} {slots:?} slot {m}");
@@ -355,8 +392,8 @@ mod tests {
                         coord[NEAR[r][slots[0]]] = 1e300;
                         coord[NEAR[r][slots[1]]] = f64::NAN;
                     }
-                    let want = compose_across(&by_coordinate(&net), k, slots, Reach::Edge);
-                    let got = compose_across(&moved, k, slots, Reach::Edge);
+                    let want = composed(&by_coordinate(&net), k, slots, Reach::Edge);
+                    let got = composed(&moved, k, slots, Reach::Edge);
                     for x in 0..3 {
                         for m in 0..10 {
                             assert_eq!(got[x][m].to_bits(), want[x][m].to_bits(), "{k} {m}");
