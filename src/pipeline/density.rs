@@ -6,6 +6,7 @@
 //! are tessellated with the base mesh's density so their vertices correspond one to one.
 
 use std::ops::Range;
+use std::sync::Mutex;
 
 use serde::Serialize;
 
@@ -13,8 +14,8 @@ use crate::mesh::TriMesh;
 use crate::options::Options;
 use crate::surface::Surface;
 use crate::tessellate::{
-    chord_error, tessellate_vertices, tessellate_with_counts, ChordErrors, DenseMesh,
-    SegmentCounts, Tessellation,
+    chord_error, tessellate_vertices, tessellate_with_held, ChordErrors, DenseMesh, HeldInteriors,
+    SegmentCounts, Tessellation, HELD_BYTES,
 };
 use crate::topology::Topology;
 
@@ -23,8 +24,41 @@ use crate::topology::Topology;
 pub(super) enum Density {
     /// Every edge at this level.
     Level(u32),
-    /// Per-edge counts, reaching `target` (the tolerance asked for, or found for the budget).
-    Counts { counts: SegmentCounts, target: f64 },
+    /// Per-edge counts, reaching `target` (the tolerance asked for, or found for the budget),
+    /// with the interior points the checks evaluated for them, for the output to write.
+    Counts {
+        counts: SegmentCounts,
+        target: f64,
+        held: Held,
+    },
+}
+
+/// The interior points a tolerance's checks evaluated at the patterns' own resolution
+/// ([`HeldInteriors`]), until the first tessellation takes them: the output is the same with
+/// or without them, so a copy of the density goes without (it is kept only to compare counts)
+/// and they are freed as soon as the output is evaluated, not held through the write.
+#[derive(Debug, Default)]
+pub(super) struct Held(Mutex<Option<HeldInteriors>>);
+
+impl Clone for Held {
+    fn clone(&self) -> Held {
+        Held::default()
+    }
+}
+
+impl Held {
+    fn new(held: HeldInteriors) -> Held {
+        Held(Mutex::new(Some(held)))
+    }
+
+    fn take(&self) -> HeldInteriors {
+        // A poisoned lock held no points worth keeping: evaluate them instead.
+        self.0
+            .lock()
+            .ok()
+            .and_then(|mut held| held.take())
+            .unwrap_or_default()
+    }
 }
 
 /// What the report says of an adaptive mesh.
@@ -62,7 +96,11 @@ impl Density {
         let errors = ChordErrors::probe(mesh, topo, surface);
         if options.triangle_budget > 0 {
             let (target, counts) = errors.for_budget(topo, options.triangle_budget, cap);
-            return Density::Counts { counts, target };
+            return Density::Counts {
+                counts,
+                target,
+                held: Held::default(),
+            };
         }
         let mut target = f64::INFINITY;
         if options.tolerance > 0.0 {
@@ -71,13 +109,17 @@ impl Density {
         if options.relative_tolerance > 0.0 {
             target = target.min(options.relative_tolerance * diagonal(mesh));
         }
-        let counts = if target > 0.0 && target.is_finite() {
-            errors.refine_to_tolerance(topo, surface, target, cap)
+        let (counts, held) = if target > 0.0 && target.is_finite() {
+            errors.refine_to_tolerance_holding(topo, surface, target, cap, HELD_BYTES)
         } else {
             // A mesh of one point: nothing to refine.
-            SegmentCounts::uniform(topo, 1)
+            (SegmentCounts::uniform(topo, 1), HeldInteriors::default())
         };
-        Density::Counts { counts, target }
+        Density::Counts {
+            counts,
+            target,
+            held: Held::new(held),
+        }
     }
 
     /// Whether `self` gives the same output as `other`: the same level, or the same counts.
@@ -109,8 +151,14 @@ impl Density {
     ) -> Tessellation<'a> {
         match self {
             Density::Level(level) => tessellate_vertices(mesh, topo, h, surface, *level, groups),
-            Density::Counts { counts, .. } => Tessellation::done(tessellate_with_counts(
-                mesh, topo, h, surface, counts, groups,
+            Density::Counts { counts, held, .. } => Tessellation::done(tessellate_with_held(
+                mesh,
+                topo,
+                h,
+                surface,
+                counts,
+                &held.take(),
+                groups,
             )),
         }
     }
@@ -129,7 +177,7 @@ impl Density {
         let surface = surface.filter(|_| measure);
         let measure = surface.is_some();
         let (counts, target) = match self {
-            Density::Counts { counts, target } => (counts.clone(), Some(*target)),
+            Density::Counts { counts, target, .. } => (counts.clone(), Some(*target)),
             Density::Level(level) if measure => (SegmentCounts::uniform(topo, *level), None),
             Density::Level(_) => return None,
         };

@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use super::blocks::{self, Block};
 use super::counts::SegmentCounts;
 use super::emit;
+use super::held::{self, HeldInteriors};
 use super::layout::GroupLayout;
 use super::transition::{Pattern, PatternKey};
 use super::{DenseMesh, VertexSource, BLOCK_TRIANGLES};
@@ -39,6 +40,32 @@ pub fn tessellate_with_counts(
     counts: &SegmentCounts,
     groups: &[Range<usize>],
 ) -> Vec<DenseMesh> {
+    tessellate_with_held(
+        mesh,
+        topo,
+        h,
+        surface,
+        counts,
+        &HeldInteriors::default(),
+        groups,
+    )
+}
+
+/// [`tessellate_with_counts`], writing the interior points `held` holds for a triangle's inner
+/// level (those its checks evaluated, [`super::ChordErrors::refine_to_tolerance_holding`])
+/// instead of evaluating them again: the same bytes.
+///
+/// # Panics
+/// As [`tessellate_with_counts`].
+pub fn tessellate_with_held(
+    mesh: &TriMesh,
+    topo: &Topology,
+    h: &[f64],
+    surface: &dyn Surface,
+    counts: &SegmentCounts,
+    held: &HeldInteriors,
+    groups: &[Range<usize>],
+) -> Vec<DenseMesh> {
     let keys: Vec<PatternKey> = (0..mesh.triangles.len())
         .into_par_iter()
         .map(|t| counts.key(topo, t))
@@ -56,6 +83,7 @@ pub fn tessellate_with_counts(
         topo,
         surface,
         counts,
+        held,
         patterns: &patterns,
         pattern_of: &pattern_of,
     };
@@ -71,6 +99,7 @@ struct Shared<'a> {
     topo: &'a Topology,
     surface: &'a dyn Surface,
     counts: &'a SegmentCounts,
+    held: &'a HeldInteriors,
     patterns: &'a [Pattern],
     pattern_of: &'a [u32],
 }
@@ -182,18 +211,25 @@ fn tessellate_block(
         }
         if !pattern.interior_by_rank.is_empty() {
             let start = pattern.interior_start as usize;
-            writer.interior(
-                &mut block,
-                &mut local,
-                tri,
-                pattern.key.inner,
-                layout.base[offset + 1] as usize - pattern.interior_by_rank.len(),
-                pattern
-                    .interior_by_rank
-                    .iter()
-                    .map(|&index| (start + index as usize, index as usize)),
-                source,
-            );
+            let first_slot = layout.base[offset + 1] as usize - pattern.interior_by_rank.len();
+            let by_rank = pattern
+                .interior_by_rank
+                .iter()
+                .map(|&index| (start + index as usize, index as usize));
+            match shared.held.get(tri, pattern.key.inner) {
+                Some(points) => held::write_interior(
+                    &mut block, &mut local, points, first_slot, by_rank, source,
+                ),
+                None => writer.interior(
+                    &mut block,
+                    &mut local,
+                    tri,
+                    pattern.key.inner,
+                    first_slot,
+                    by_rank,
+                    source,
+                ),
+            }
         }
         let start = index_base[offset] - block.index_base;
         emit::triangles(

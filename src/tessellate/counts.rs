@@ -31,6 +31,7 @@ use rayon::prelude::*;
 use super::chord::{corner_error, measured_error};
 use super::estimate::{Curvature, PatternError, PatternModel};
 use super::evaluator;
+use super::held::{HeldInteriors, Holding};
 use super::transition::{Pattern, PatternKey};
 use crate::mesh::TriMesh;
 use crate::surface::{lattice_index, Surface, SurfacePoint};
@@ -269,6 +270,35 @@ impl ChordErrors {
         tolerance: f64,
         cap: u32,
     ) -> SegmentCounts {
+        self.refine(topo, surface, tolerance, cap, None)
+    }
+
+    /// [`ChordErrors::refine_to_tolerance`], holding up to `held_bytes` of the interior points
+    /// stage 1 evaluates at the patterns' own resolution (`held.rs`) for the output to write
+    /// instead of evaluating them again: the same counts, and with
+    /// [`super::tessellate_with_held`] the same output bytes.
+    pub fn refine_to_tolerance_holding(
+        &self,
+        topo: &Topology,
+        surface: &dyn Surface,
+        tolerance: f64,
+        cap: u32,
+        held_bytes: usize,
+    ) -> (SegmentCounts, HeldInteriors) {
+        let holding = Holding::new(held_bytes);
+        let counts = self.refine(topo, surface, tolerance, cap, Some(&holding));
+        let held = holding.finish(&counts.inner);
+        (counts, held)
+    }
+
+    fn refine(
+        &self,
+        topo: &Topology,
+        surface: &dyn Surface,
+        tolerance: f64,
+        cap: u32,
+        holding: Option<&Holding>,
+    ) -> SegmentCounts {
         let predicted = (tolerance - self.rounding).max(0.5 * tolerance);
         let mut counts = self.counts_with_margin(topo, predicted, cap, 1.0);
         // Per triangle, the packed key of the pattern whose last check at its own resolution
@@ -300,6 +330,13 @@ impl ChordErrors {
                         points.clear();
                         surface.evaluate_lattice(tri, level, points);
                         curvature.read(points, level);
+                        // At the pattern's own inner level the lattice's interior is the
+                        // output's, if the counts stay.
+                        if factor == 1 && level == model.inner() {
+                            if let Some(holding) = holding {
+                                holding.offer(tri, level, points);
+                            }
+                        }
                     }
                     let error = model.error(curvature);
                     if factor == 1 {

@@ -57,6 +57,7 @@ mod chord;
 mod counts;
 mod emit;
 mod estimate;
+mod held;
 mod lattice_edges;
 mod layout;
 mod plan;
@@ -71,9 +72,10 @@ use plan::LatticePlan;
 use rayon::prelude::*;
 use std::ops::Range;
 
-pub use adaptive::tessellate_with_counts;
+pub use adaptive::{tessellate_with_counts, tessellate_with_held};
 pub use chord::chord_error;
 pub use counts::{ChordErrors, SegmentCounts, PROBE_KEPT_BYTES, PROBE_LEVEL};
+pub use held::{HeldInteriors, HELD_BYTES};
 
 /// Where an output vertex was sampled: a source triangle (index into the whole mesh) and a point
 /// of that triangle's level-n lattice. Attributes are interpolated from these.

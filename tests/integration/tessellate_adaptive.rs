@@ -9,8 +9,8 @@ use crate::support::*;
 use g2tess::mesh::TriMesh;
 use g2tess::surface::{G2Surface, LatticePart, Profile, Surface, SurfacePoint};
 use g2tess::tessellate::{
-    chord_error, tessellate, tessellate_with_counts, ChordErrors, DenseMesh, SegmentCounts,
-    PROBE_KEPT_BYTES, PROBE_LEVEL,
+    chord_error, tessellate, tessellate_with_counts, tessellate_with_held, ChordErrors, DenseMesh,
+    SegmentCounts, HELD_BYTES, PROBE_KEPT_BYTES, PROBE_LEVEL,
 };
 use g2tess::topology::Topology;
 use glam::DVec3;
@@ -564,4 +564,99 @@ fn a_probe_too_large_to_keep_is_evaluated_again_to_the_same_counts() {
         mesh.triangles.len(),
         "not every triangle's probe lattice was evaluated again"
     );
+}
+
+/// Counts the interiors evaluated as a lattice part (what the output's write asks for).
+struct CountingInteriors<'a> {
+    inner: &'a dyn Surface,
+    interiors: Mutex<usize>,
+}
+
+impl Surface for CountingInteriors<'_> {
+    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
+        self.inner.evaluate(tri, bary)
+    }
+
+    fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
+        self.inner.evaluate_lattice(tri, level, out);
+    }
+
+    fn evaluate_lattice_part(
+        &self,
+        tri: usize,
+        level: u32,
+        part: LatticePart,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        if part == LatticePart::Interior {
+            *self.interiors.lock().unwrap() += 1;
+        }
+        self.inner.evaluate_lattice_part(tri, level, part, out);
+    }
+
+    fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
+        self.inner.evaluate_points(tri, barys, out);
+    }
+}
+
+/// Every value of `a` and `b` as bits (so −0 and 0 differ and NaN equals itself).
+fn assert_same_bits(a: &DenseMesh, b: &DenseMesh, what: &str) {
+    let bits = |v: &[[f32; 3]]| v.iter().map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&a.positions), bits(&b.positions), "{what}: positions");
+    assert_eq!(bits(&a.normals), bits(&b.normals), "{what}: normals");
+    assert_eq!(a.sources, b.sources, "{what}: sources");
+    assert_eq!(a.indices, b.indices, "{what}: indices");
+}
+
+#[test]
+fn the_held_interiors_are_the_output_interiors_bit_for_bit() {
+    // Stage 1 evaluates each triangle's lattice at its inner level, whose interior is the
+    // output's: held from the checks, it is written instead of evaluated again, with the same
+    // bytes (were a held point rounded differently, or a lattice of another level written, a
+    // position or normal would differ). Not vacuous: every triangle's inner level here is above
+    // the probe's, so nearly every interior comes from what was held, and the write evaluates
+    // only the others. A bound too small to hold any gives the same counts and bytes, evaluated.
+    // 1,280-triangle icosphere at the error level 16 reaches (about 1.8e-5).
+    let mesh = icosphere(3);
+    let topo = Topology::build(&mesh);
+    let hs = h_all(&topo, 0.2);
+    let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
+    let errors = ChordErrors::probe(&mesh, &topo, &surface);
+    let tolerance = 1.8e-5;
+    let plain_counts = errors.refine_to_tolerance(&topo, &surface, tolerance, 64);
+    assert!(*plain_counts.inner.iter().min().unwrap() > PROBE_LEVEL);
+    let groups = [0..mesh.triangles.len()];
+    let plain = tessellate_with_counts(&mesh, &topo, &hs, &surface, &plain_counts, &groups);
+    for (bound, held_all) in [(HELD_BYTES, true), (0, false)] {
+        let (counts, held) =
+            errors.refine_to_tolerance_holding(&topo, &surface, tolerance, 64, bound);
+        assert_eq!(counts, plain_counts, "holding changed the counts");
+        if held_all {
+            // A triangle whose inner level stages 2 and 3 raised past its last stage-1 check
+            // holds nothing: few.
+            let triangles = mesh.triangles.len();
+            assert!(
+                10 * held.len() >= 9 * triangles,
+                "{} of {triangles} interiors held",
+                held.len()
+            );
+        } else {
+            assert!(held.is_empty(), "held past the bound");
+        }
+        let counting = CountingInteriors {
+            inner: &surface,
+            interiors: Mutex::new(0),
+        };
+        let dense = tessellate_with_held(&mesh, &topo, &hs, &counting, &counts, &held, &groups);
+        assert_eq!(dense.len(), plain.len());
+        for (a, b) in dense.iter().zip(&plain) {
+            assert_same_bits(a, b, &format!("held up to {bound} bytes"));
+        }
+        let evaluated = counting.interiors.into_inner().unwrap();
+        assert_eq!(
+            evaluated,
+            mesh.triangles.len() - held.len(),
+            "interiors evaluated at the write"
+        );
+    }
 }
