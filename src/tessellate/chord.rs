@@ -119,16 +119,7 @@ fn triangle_errors(
     samples.barys.clear();
     let chosen = (0..pattern.triangles.len()).filter(|&t| selected(t));
     for t in chosen.clone() {
-        let bary = pattern.triangles[t].map(|p| pattern.bary(p));
-        for w in WEIGHTS {
-            let mut domain = [0.0; 3];
-            for (c, b) in bary.iter().enumerate() {
-                for (d, x) in domain.iter_mut().zip(b) {
-                    *d += w[c] * x;
-                }
-            }
-            samples.barys.push(domain);
-        }
+        samples.barys.extend(sample_barys(pattern, t));
     }
     samples.points.clear();
     surface.evaluate_points(tri, &samples.barys, &mut samples.points);
@@ -222,38 +213,110 @@ pub(crate) fn measured_error(
     error
 }
 
+/// The output triangles of a pattern at its source triangle's corners (those with a corner
+/// among their vertices) and the domain points [`corner_error`] evaluates for them: the same
+/// for every source triangle with that pattern, so found once per pattern instead of once per
+/// check (a pass over the pattern's triangles, a sort, and the samples' weights).
+#[derive(Debug)]
+pub(crate) struct CornerTriangles {
+    /// The triangles, ascending, each with the source triangle's edges it touches
+    /// ([`Pattern::touches`]) and its corners as indices into the evaluated points.
+    triangles: Vec<(u8, [u32; 3])>,
+    /// The triangles' vertices' barycentrics (each vertex once, by ascending point), then
+    /// each triangle's [`WEIGHTS`] samples, triangle after triangle.
+    barys: Vec<[f64; 3]>,
+}
+
+impl CornerTriangles {
+    /// The corner triangles of `pattern`.
+    pub fn new(pattern: &Pattern) -> CornerTriangles {
+        let at_corner: Vec<usize> = (0..pattern.triangles.len())
+            .filter(|&t| pattern.triangles[t].iter().any(|&p| p < 3))
+            .collect();
+        let mut used: Vec<u32> = at_corner
+            .iter()
+            .flat_map(|&t| pattern.triangles[t])
+            .collect();
+        used.sort_unstable();
+        used.dedup();
+        let mut barys: Vec<[f64; 3]> = used.iter().map(|&p| pattern.bary(p)).collect();
+        for &t in &at_corner {
+            barys.extend(sample_barys(pattern, t));
+        }
+        let triangles = at_corner
+            .iter()
+            .map(|&t| {
+                let corners = pattern.triangles[t]
+                    .map(|p| used.binary_search(&p).expect("every vertex is listed") as u32);
+                (pattern.touches(t), corners)
+            })
+            .collect();
+        CornerTriangles { triangles, barys }
+    }
+}
+
+/// The domain points of the [`WEIGHTS`] samples of output triangle `t` of `pattern`.
+fn sample_barys(pattern: &Pattern, t: usize) -> impl Iterator<Item = [f64; 3]> {
+    let bary = pattern.triangles[t].map(|p| pattern.bary(p));
+    WEIGHTS.into_iter().map(move |w| {
+        let mut domain = [0.0; 3];
+        for (c, b) in bary.iter().enumerate() {
+            for (d, x) in domain.iter_mut().zip(b) {
+                *d += w[c] * x;
+            }
+        }
+        domain
+    })
+}
+
 /// [`measured_error`] of the output triangles at the source triangle's corners only (those
-/// with a corner among their vertices), their vertices evaluated point by point: the part of a
-/// pattern the lattice estimate (`estimate.rs`) cannot see, because the G² blend's curvature
-/// near a vertex varies on the scale of the distance to it (the corner wedge, where `β` depends
-/// on the direction only), so the second differences one lattice step in miss it. About 21
-/// surface points per source triangle, whatever its counts.
+/// with a corner among their vertices, `corners`, of `pattern`), their vertices evaluated
+/// point by point: the part of a pattern the lattice estimate (`estimate.rs`) cannot see,
+/// because the G² blend's curvature near a vertex varies on the scale of the distance to it
+/// (the corner wedge, where `β` depends on the direction only), so the second differences one
+/// lattice step in miss it. About 30 surface points per source triangle, whatever its counts,
+/// evaluated in one call (the surface sets the triangle and its neighbours up once for the
+/// vertices and the samples). The same values as measuring the selected triangles with
+/// [`errors_by_part`], bit for bit: the same points, weights and sums in the same order.
 pub(crate) fn corner_error(
     surface: &dyn Surface,
     tri: usize,
-    pattern: &Pattern,
+    corners: &CornerTriangles,
     samples: &mut Samples,
 ) -> PatternError {
-    let at_corner = |t: usize| pattern.triangles[t].iter().any(|&p| p < 3);
-    let mut used: Vec<u32> = (0..pattern.triangles.len())
-        .filter(|&t| at_corner(t))
-        .flat_map(|t| pattern.triangles[t])
-        .collect();
-    used.sort_unstable();
-    used.dedup();
-    samples.barys.clear();
-    samples.barys.extend(used.iter().map(|&p| pattern.bary(p)));
     samples.points.clear();
-    surface.evaluate_points(tri, &samples.barys, &mut samples.points);
-    let mut vertices = std::mem::take(&mut samples.vertices);
-    vertices.clear();
-    vertices.resize(pattern.lattice.len(), DVec3::ZERO);
-    for (&p, s) in used.iter().zip(&samples.points) {
-        vertices[p as usize] = written(s.position);
+    surface.evaluate_points(tri, &corners.barys, &mut samples.points);
+    let on_surface_from = corners.barys.len() - WEIGHTS.len() * corners.triangles.len();
+    let (vertices, on_surface) = samples.points.split_at(on_surface_from);
+    let mut error = PatternError::default();
+    for (&(touches, at), on_surface) in corners
+        .triangles
+        .iter()
+        .zip(on_surface.chunks_exact(WEIGHTS.len()))
+    {
+        let flat = at.map(|v| written(vertices[v as usize].position));
+        let mut worst = 0.0f64;
+        for (w, s) in WEIGHTS.iter().zip(on_surface) {
+            let on_flat = w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2];
+            worst = worst.max(normal_distance(on_flat, s));
+        }
+        add_by_part(&mut error, touches, worst);
     }
-    let error = errors_by_part(surface, tri, pattern, at_corner, &vertices, samples);
-    samples.vertices = vertices;
     error
+}
+
+/// Adds the error `e` of an output triangle touching the source triangle's edges `touches`
+/// (none: the inner lattice) to the parts' maxima.
+#[inline]
+fn add_by_part(error: &mut PatternError, touches: u8, e: f64) {
+    if touches == 0 {
+        error.inner = error.inner.max(e);
+    }
+    for (k, edge) in error.edges.iter_mut().enumerate() {
+        if touches & (1 << k) != 0 {
+            *edge = edge.max(e);
+        }
+    }
 }
 
 /// The chord errors of the `selected` output triangles of `pattern`, whose vertex `p` is at
@@ -274,17 +337,53 @@ fn errors_by_part(
         selected,
         |t, c| vertices[pattern.triangles[t][c] as usize],
         samples,
-        |t, e| {
-            let touches = pattern.touches(t);
-            if touches == 0 {
-                error.inner = error.inner.max(e);
-            }
-            for (k, edge) in error.edges.iter_mut().enumerate() {
-                if touches & (1 << k) != 0 {
-                    *edge = edge.max(e);
-                }
-            }
-        },
+        |t, e| add_by_part(&mut error, pattern.touches(t), e),
     );
     error
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A height field over the equilateral triangle, curved differently along each direction
+    /// and fastest near corner 0, so that the corner triangles' errors differ part by part.
+    struct Field;
+
+    impl Surface for Field {
+        fn evaluate(&self, _tri: usize, b: [f64; 3]) -> SurfacePoint {
+            let (x, y) = (b[1] + 0.5 * b[2], 0.75f64.sqrt() * b[2]);
+            let z = 0.3 * (3.0 * x).sin() * (2.0 * y).cos() + 0.2 * (x * x + 0.1).sqrt();
+            let zx = 0.9 * (3.0 * x).cos() * (2.0 * y).cos() + 0.2 * x / (x * x + 0.1).sqrt();
+            let zy = -0.6 * (3.0 * x).sin() * (2.0 * y).sin();
+            SurfacePoint {
+                position: DVec3::new(x, y, z),
+                normal: DVec3::new(-zx, -zy, 1.0).normalize(),
+            }
+        }
+    }
+
+    /// [`corner_error`] with its corner triangles found once per pattern and every point
+    /// evaluated in one call gives what measuring the triangles at the corners one by one gives
+    /// ([`errors_by_part`] on the vertices as evaluated), bit for bit, part by part.
+    #[test]
+    fn the_corner_error_is_that_of_the_corner_triangles_measured_one_by_one() {
+        let keys = [([20, 20, 20], 20), ([17, 16, 20], 18), ([13, 9, 18], 14)];
+        for (edges, inner) in keys {
+            let pattern = Pattern::new(PatternKey { edges, inner });
+            let at_corner = |t: usize| pattern.triangles[t].iter().any(|&p| p < 3);
+            let vertices: Vec<DVec3> = (0..pattern.lattice.len() as u32)
+                .map(|p| written(Field.evaluate(0, pattern.bary(p)).position))
+                .collect();
+            let mut samples = Samples::default();
+            let plain = errors_by_part(&Field, 0, &pattern, at_corner, &vertices, &mut samples);
+            let corners = CornerTriangles::new(&pattern);
+            let fast = corner_error(&Field, 0, &corners, &mut samples);
+            let bits =
+                |e: PatternError| [e.inner, e.edges[0], e.edges[1], e.edges[2]].map(f64::to_bits);
+            assert_eq!(bits(fast), bits(plain), "{edges:?} {inner}");
+            // Not vacuous: every edge's corner triangles have an error.
+            assert!(plain.edges.iter().all(|&e| e > 0.0), "{plain:?}");
+        }
+    }
 }

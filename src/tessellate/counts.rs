@@ -28,7 +28,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use super::chord::{corner_error, measured_error};
+use super::chord::{corner_error, measured_error, CornerTriangles};
 use super::estimate::{Curvature, PatternError, PatternModel};
 use super::evaluator;
 use super::held::{HeldInteriors, Holding};
@@ -365,12 +365,14 @@ impl ChordErrors {
             topo,
             tolerance,
             cap,
-            Pattern::new,
-            |tri, pattern, samples, _: &[()], _: &mut Vec<()>| {
-                if pattern.key.inner > MEASURED_UP_TO {
-                    return corner_error(surface, tri, pattern, samples);
-                }
-                measured_error(surface, tri, pattern, samples)
+            |key| {
+                let pattern = Pattern::new(key);
+                let corners = (key.inner > MEASURED_UP_TO).then(|| CornerTriangles::new(&pattern));
+                (pattern, corners)
+            },
+            |tri, (pattern, corners), samples, _: &[()], _: &mut Vec<()>| match corners {
+                Some(corners) => corner_error(surface, tri, corners, samples),
+                None => measured_error(surface, tri, pattern, samples),
             },
         );
         counts
