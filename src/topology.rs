@@ -241,6 +241,10 @@ impl Topology {
         } = group_uses(&tri_verts, welded_positions.len());
 
         let uses_of = |e: usize| &uses[use_start[e] as usize..use_start[e + 1] as usize];
+        // Where the weld joined no two input vertices, every welded vertex is one input vertex
+        // with one normal (finite: the normals were checked and repaired before), so no edge's
+        // triangles can disagree on one: nothing to compare.
+        let one_normal_each = welded_positions.len() == mesh.positions.len();
         let (edge_kinds, split_normals): (Vec<EdgeKind>, Vec<bool>) = (0..edge_verts.len())
             .into_par_iter()
             .map(|e| {
@@ -255,7 +259,8 @@ impl Topology {
                         _ => EdgeKind::NonManifold,
                     }
                 };
-                (kind, has_split_normals(verts, tris, mesh, &tri_verts))
+                let split = !one_normal_each && has_split_normals(verts, tris, mesh, &tri_verts);
+                (kind, split)
             })
             .unzip();
 
@@ -649,14 +654,17 @@ fn is_degenerate(v: &[VertId; 3], positions: &[DVec3]) -> bool {
 
 /// Whether the triangles using an edge (`verts`, `tris`) disagree on the input normal at
 /// either end point; each use's triangle is read once for both end points.
+///
+/// Corners that are the same input vertex carry the same normal: their normals are compared
+/// only where the input vertices differ (a seam), so an edge of an indexed mesh reads no normal.
 fn has_split_normals(
     verts: [VertId; 2],
     tris: &[EdgeUse],
     mesh: &TriMesh,
     tri_verts: &[[VertId; 3]],
 ) -> bool {
-    // The first normal seen at each end point.
-    let mut first: [Option<DVec3>; 2] = [None; 2];
+    // The first input vertex seen at each end point.
+    let mut first: [Option<u32>; 2] = [None; 2];
     for u in tris {
         let t = u.tri().0 as usize;
         let (welded, input) = (tri_verts[t], mesh.triangles[t]);
@@ -664,10 +672,12 @@ fn has_split_normals(
             let Some(corner) = welded.iter().position(|&c| c == v) else {
                 continue;
             };
-            let n = mesh.normals[input[corner] as usize];
-            match seen {
-                None => *seen = Some(n),
-                Some(f) if *f != n => return true,
+            let i = input[corner];
+            match *seen {
+                None => *seen = Some(i),
+                Some(f) if f != i && mesh.normals[f as usize] != mesh.normals[i as usize] => {
+                    return true
+                }
                 Some(_) => {}
             }
         }
@@ -841,6 +851,53 @@ pub(crate) mod tests {
             normals,
             triangles,
         }
+    }
+
+    /// An edge's normals split exactly where two of its uses put different normals at one end
+    /// point (every pair compared), on odd shapes whose repeated positions carry the same or
+    /// different normals; and never where the weld joins nothing, whatever the normals.
+    #[test]
+    fn split_normals_match_every_pair_of_corners() {
+        for seed in 0..40 {
+            let mut mesh = odd_mesh(seed, 10 + 7 * seed as usize);
+            // Every vertex its own normal half the time: seams with equal and unequal normals.
+            if seed % 2 == 1 {
+                let n = mesh.positions.len();
+                mesh.normals = (0..n).map(|i| DVec3::new(i as f64, 1.0, 0.0)).collect();
+            }
+            let topo = Topology::build(&mesh);
+            for edge in topo.edges() {
+                let normal_at = |u: &EdgeUse, v: VertId| {
+                    let (t, welded) = (u.at().0, topo.tri_verts[u.at().0]);
+                    let c = welded.iter().position(|&w| w == v)?;
+                    Some(mesh.normals[mesh.triangles[t][c] as usize])
+                };
+                let split = edge.verts.iter().any(|&v| {
+                    edge.tris.iter().any(|a| {
+                        edge.tris
+                            .iter()
+                            .any(|b| match (normal_at(a, v), normal_at(b, v)) {
+                                (Some(x), Some(y)) => x != y,
+                                _ => false,
+                            })
+                    })
+                });
+                assert_eq!(
+                    edge.split_normals, split,
+                    "seed {seed} edge {:?}",
+                    edge.verts
+                );
+            }
+        }
+        // Distinct positions, a different normal at every vertex: nothing is split.
+        let mesh = TriMesh {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::ONE],
+            normals: vec![DVec3::X, DVec3::Y, DVec3::Z, DVec3::NEG_X],
+            triangles: vec![[0, 1, 2], [2, 1, 3]],
+        };
+        let topo = Topology::build(&mesh);
+        assert_eq!(topo.edge_count(), 5);
+        assert!(topo.edges().all(|e| !e.split_normals));
     }
 
     #[test]
