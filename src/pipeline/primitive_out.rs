@@ -50,11 +50,7 @@ impl Prepared {
         triangles: Vec<[u32; 3]>,
         needs_tangents: Option<u32>,
     ) -> Self {
-        let exact_normals = data.normals().map(|v| {
-            v.chunks_exact(3)
-                .map(|c| [c[0], c[1], c[2]])
-                .collect::<Vec<_>>()
-        });
+        let exact_normals = data.normals().map(triples_in_blocks);
         let source_vertex_count = positions.len();
         Prepared {
             data,
@@ -121,6 +117,24 @@ impl Prepared {
     pub fn vertex_count(&self) -> u32 {
         self.positions.len() as u32
     }
+}
+
+/// Triples copied per task of [`triples_in_blocks`].
+const TRIPLE_BLOCK: usize = 1 << 14;
+
+/// `values` as triples, in order (whole triples only). In parallel blocks into an array
+/// allocated zeroed, each block faulting in and filling its own pages: a serial copy of a
+/// million-vertex primitive's normals was a run's last serial pass before the weld.
+fn triples_in_blocks(values: &[f32]) -> Vec<[f32; 3]> {
+    let mut out = vec![[0.0; 3]; values.len() / 3];
+    out.par_chunks_mut(TRIPLE_BLOCK)
+        .zip(values.par_chunks(3 * TRIPLE_BLOCK))
+        .for_each(|(out, values)| {
+            for (o, c) in out.iter_mut().zip(values.chunks_exact(3)) {
+                *o = [c[0], c[1], c[2]];
+            }
+        });
+    out
 }
 
 /// Whether a float attribute holds identifiers that must come from one corner, never blended.
@@ -398,4 +412,27 @@ fn target_attributes(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// More than one block, a part of one, and a trailing partial triple: every whole triple
+    /// copied bit for bit, in order (NaN payloads included), the partial one dropped.
+    #[test]
+    fn triples_cross_block_edges_bit_for_bit() {
+        let n = 2 * TRIPLE_BLOCK + 1234;
+        let values: Vec<f32> = (0..3 * n as u32 + 2)
+            .map(|i| f32::from_bits(i.wrapping_mul(2_654_435_761)))
+            .collect();
+        let triples = triples_in_blocks(&values);
+        assert_eq!(triples.len(), n);
+        for (i, t) in triples.iter().enumerate() {
+            for k in 0..3 {
+                assert_eq!(t[k].to_bits(), values[3 * i + k].to_bits(), "triple {i}");
+            }
+        }
+        assert!(triples_in_blocks(&[1.0, 2.0]).is_empty());
+    }
 }
