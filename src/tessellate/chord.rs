@@ -124,14 +124,24 @@ fn triangle_errors(
     samples.points.clear();
     surface.evaluate_points(tri, &samples.barys, &mut samples.points);
     for (t, on_surface) in chosen.zip(samples.points.chunks_exact(WEIGHTS.len())) {
-        let flat = [0, 1, 2].map(|c| corner(t, c));
-        let mut worst = 0.0f64;
-        for (w, s) in WEIGHTS.iter().zip(on_surface) {
-            let on_flat = w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2];
-            worst = worst.max(normal_distance(on_flat, s));
-        }
-        each(t, worst);
+        each(
+            t,
+            sampled_error([0, 1, 2].map(|c| corner(t, c)), on_surface),
+        );
     }
+}
+
+/// The chord error of the output triangle with corners `flat`: the largest distance of its
+/// [`WEIGHTS`] sample points from the surface's tangent planes at `on_surface`, the surface
+/// points of the same domain points.
+#[inline]
+fn sampled_error(flat: [DVec3; 3], on_surface: &[SurfacePoint]) -> f64 {
+    let mut worst = 0.0f64;
+    for (w, s) in WEIGHTS.iter().zip(on_surface) {
+        let on_flat = w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2];
+        worst = worst.max(normal_distance(on_flat, s));
+    }
+    worst
 }
 
 /// Where an output vertex at `p` is written: its `f32` rounding, as the tessellators write it
@@ -295,12 +305,7 @@ pub(crate) fn corner_error(
         .zip(on_surface.chunks_exact(WEIGHTS.len()))
     {
         let flat = at.map(|v| written(vertices[v as usize].position));
-        let mut worst = 0.0f64;
-        for (w, s) in WEIGHTS.iter().zip(on_surface) {
-            let on_flat = w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2];
-            worst = worst.max(normal_distance(on_flat, s));
-        }
-        add_by_part(&mut error, touches, worst);
+        add_by_part(&mut error, touches, sampled_error(flat, on_surface));
     }
     error
 }

@@ -63,13 +63,9 @@ impl Holding {
     pub fn offer(&self, tri: usize, level: u32, points: &[SurfacePoint]) {
         let len = (level.saturating_sub(1) * level.saturating_sub(2) / 2) as usize;
         let bytes = len * std::mem::size_of::<HeldPoint>();
-        {
-            let held = self.held.lock().expect("no check panics while holding");
-            let before = held.by_tri.get(&(tri as u32)).map_or(0, |(_, p)| p.len());
-            let after = held.bytes - before * std::mem::size_of::<HeldPoint>() + bytes;
-            if len == 0 || after > self.limit {
-                return;
-            }
+        let fits = |held: &HeldInteriors| self.held_after(held, tri, bytes);
+        if len == 0 || fits(&self.held.lock().expect("no check panics while holding")).is_none() {
+            return;
         }
         let mut interior = Vec::with_capacity(len);
         for j in 1..level {
@@ -84,15 +80,20 @@ impl Holding {
         }
         debug_assert_eq!(interior.len(), len);
         let mut held = self.held.lock().expect("no check panics while holding");
-        let held = &mut *held;
-        let before = held.by_tri.get(&(tri as u32)).map_or(0, |(_, p)| p.len());
-        let after = held.bytes - before * std::mem::size_of::<HeldPoint>() + bytes;
         // Another thread may have taken the room meanwhile.
-        if after <= self.limit {
+        if let Some(after) = fits(&held) {
             held.bytes = after;
             held.by_tri
                 .insert(tri as u32, (level, interior.into_boxed_slice()));
         }
+    }
+
+    /// The bytes `held` would hold with `bytes` of points for `tri` in place of what it holds
+    /// for it now, if that is within the limit.
+    fn held_after(&self, held: &HeldInteriors, tri: usize, bytes: usize) -> Option<usize> {
+        let before = held.by_tri.get(&(tri as u32)).map_or(0, |(_, p)| p.len());
+        let after = held.bytes - before * std::mem::size_of::<HeldPoint>() + bytes;
+        (after <= self.limit).then_some(after)
     }
 
     /// What is held for the triangles whose inner level in `inner` is the one held: the rest

@@ -409,6 +409,18 @@ fn a_budget_leaves_a_flat_mesh_at_one_segment_per_edge() {
 struct CountingLattices<'a> {
     inner: &'a dyn Surface,
     lattices: Mutex<HashMap<(usize, u32), u32>>,
+    /// Interiors evaluated as a lattice part (what the output's write asks for).
+    interiors: Mutex<usize>,
+}
+
+impl<'a> CountingLattices<'a> {
+    fn new(inner: &'a dyn Surface) -> Self {
+        CountingLattices {
+            inner,
+            lattices: Mutex::new(HashMap::new()),
+            interiors: Mutex::new(0),
+        }
+    }
 }
 
 impl Surface for CountingLattices<'_> {
@@ -433,6 +445,9 @@ impl Surface for CountingLattices<'_> {
         part: LatticePart,
         out: &mut Vec<SurfacePoint>,
     ) {
+        if part == LatticePart::Interior {
+            *self.interiors.lock().unwrap() += 1;
+        }
         self.inner.evaluate_lattice_part(tri, level, part, out);
     }
 
@@ -456,10 +471,7 @@ fn no_lattice_finer_than_the_probe_is_evaluated_twice() {
     let errors = ChordErrors::probe(&mesh, &topo, &surface);
     let mut rechecked = 0;
     for tolerance in [1.8e-5, 4.5e-6] {
-        let counting = CountingLattices {
-            inner: &surface,
-            lattices: Mutex::new(HashMap::new()),
-        };
+        let counting = CountingLattices::new(&surface);
         let counts = errors.refine_to_tolerance(&topo, &counting, tolerance, 64);
         let lattices = counting.lattices.into_inner().unwrap();
         let twice: Vec<_> = lattices
@@ -498,10 +510,7 @@ fn the_counts_settle_on_the_probe_lattice() {
     let topo = Topology::build(&mesh);
     let hs = h_all(&topo, 0.2);
     let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
-    let counting = CountingLattices {
-        inner: &surface,
-        lattices: Mutex::new(HashMap::new()),
-    };
+    let counting = CountingLattices::new(&surface);
     let counts = ChordErrors::probe(&mesh, &topo, &surface)
         .refine_to_tolerance(&topo, &counting, 4.5e-6, 64);
     let lattices = counting.lattices.into_inner().unwrap();
@@ -538,10 +547,7 @@ fn a_probe_too_large_to_keep_is_evaluated_again_to_the_same_counts() {
     let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
     let mut results = Vec::new();
     for kept_bytes in [PROBE_KEPT_BYTES, 0] {
-        let counting = CountingLattices {
-            inner: &surface,
-            lattices: Mutex::new(HashMap::new()),
-        };
+        let counting = CountingLattices::new(&surface);
         let counts = ChordErrors::probe_keeping(&mesh, &topo, &surface, kept_bytes)
             .refine_to_tolerance(&topo, &counting, 4.5e-6, 64);
         assert!(*counts.inner.iter().min().unwrap() > PROBE_LEVEL);
@@ -564,39 +570,6 @@ fn a_probe_too_large_to_keep_is_evaluated_again_to_the_same_counts() {
         mesh.triangles.len(),
         "not every triangle's probe lattice was evaluated again"
     );
-}
-
-/// Counts the interiors evaluated as a lattice part (what the output's write asks for).
-struct CountingInteriors<'a> {
-    inner: &'a dyn Surface,
-    interiors: Mutex<usize>,
-}
-
-impl Surface for CountingInteriors<'_> {
-    fn evaluate(&self, tri: usize, bary: [f64; 3]) -> SurfacePoint {
-        self.inner.evaluate(tri, bary)
-    }
-
-    fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
-        self.inner.evaluate_lattice(tri, level, out);
-    }
-
-    fn evaluate_lattice_part(
-        &self,
-        tri: usize,
-        level: u32,
-        part: LatticePart,
-        out: &mut Vec<SurfacePoint>,
-    ) {
-        if part == LatticePart::Interior {
-            *self.interiors.lock().unwrap() += 1;
-        }
-        self.inner.evaluate_lattice_part(tri, level, part, out);
-    }
-
-    fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
-        self.inner.evaluate_points(tri, barys, out);
-    }
 }
 
 /// Every value of `a` and `b` as bits (so −0 and 0 differ and NaN equals itself).
@@ -643,10 +616,7 @@ fn the_held_interiors_are_the_output_interiors_bit_for_bit() {
         } else {
             assert!(held.is_empty(), "held past the bound");
         }
-        let counting = CountingInteriors {
-            inner: &surface,
-            interiors: Mutex::new(0),
-        };
+        let counting = CountingLattices::new(&surface);
         let dense = tessellate_with_held(&mesh, &topo, &hs, &counting, &counts, &held, &groups);
         assert_eq!(dense.len(), plain.len());
         for (a, b) in dense.iter().zip(&plain) {
