@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::VertId;
+use super::{filled, pieces_of, VertId};
 
 /// Vertices one task of the partition (and of the numbering) reads.
 const BLOCK: usize = 1 << 16;
@@ -188,13 +188,19 @@ fn number_by_first_use(positions: &[DVec3], first: &[u32]) -> (Vec<VertId>, Vec<
         .par_iter()
         .map(|&f| VertId(rank[f as usize]))
         .collect();
-    let mut welded = Vec::with_capacity(distinct);
-    welded.par_extend(
-        (0..first.len())
-            .into_par_iter()
-            .filter(|&i| is_first(i))
-            .map(|i| positions[i]),
-    );
+    // Each block's first uses straight into their place: a filtered parallel iterator would
+    // gather them in per-thread pieces and copy those into the result on one thread.
+    let mut welded = filled(DVec3::ZERO, distinct);
+    let lengths: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
+    pieces_of(&mut welded, &lengths)
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(b, out)| {
+            let r = b * BLOCK..((b + 1) * BLOCK).min(first.len());
+            for (o, i) in out.iter_mut().zip(r.filter(|&i| is_first(i))) {
+                *o = positions[i];
+            }
+        });
     (ids, welded)
 }
 
