@@ -127,7 +127,7 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Document> {
         ));
     }
     // Read once, and kept: a GLB's BIN chunk becomes the first buffer where it lies.
-    let bytes = Arc::new(std::fs::read(path).map_err(|e| Error::io(&shown, e))?);
+    let bytes = Arc::new(super::read_file::read_whole(path).map_err(|e| Error::io(&shown, e))?);
     let named_glb = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("glb"));

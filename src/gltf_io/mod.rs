@@ -20,6 +20,7 @@
 //! - [`stream`]: an output written (or compared with disk) while its document is being made
 //! - `compare`: bytes compared with a file in chunks as they are produced (`--check`)
 //! - [`lod`]: coarser levels of detail as new meshes and nodes linked by `MSFT_lod`
+//! - `read_file`: a file's bytes read by every thread at once
 //! - [`files`]: the files an asset reads and the files an output consists of, by name
 //! - `bounds`: accessor `min`/`max`, in parallel
 //! - `buffer_data`: buffers held in the element type they were made in, shared with the writer
@@ -41,6 +42,7 @@ pub mod meshopt_decode;
 pub mod meshopt_encode;
 pub mod primitive;
 pub mod quantize;
+mod read_file;
 pub mod stream;
 pub mod uri;
 pub mod validate;
