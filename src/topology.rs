@@ -336,6 +336,12 @@ impl Topology {
         self.edge_kinds[id.0 as usize]
     }
 
+    /// Whether the triangles of edge `id` carry different input normals at one of its ends
+    /// ([`Edge::split_normals`]), alone (no view assembled).
+    pub fn split_normals(&self, id: EdgeId) -> bool {
+        self.split_normals[id.0 as usize]
+    }
+
     /// The end points of edge `id`, smaller id first.
     pub fn edge_verts(&self, id: EdgeId) -> [VertId; 2] {
         self.edge_verts[id.0 as usize]

@@ -239,6 +239,30 @@ impl<'a> G2Surface<'a> {
         })
     }
 
+    /// The [`Split`] of blended edge `k` of triangle `tri`, whose own corner normals are
+    /// `normal`. Most edges have no split normals, and the topology's flag says so without
+    /// reading the neighbour (it compares the input normals themselves: where they are equal,
+    /// so are the unit normals made from them); only flagged edges compare the unit normals.
+    #[inline]
+    fn split_across(&self, tri: usize, k: usize, normal: &[DVec3; 3]) -> Option<Split> {
+        if !self.topo.split_normals(self.topo.tri_edges[tri][k]) {
+            return None;
+        }
+        self.split_of_flagged(tri, k, normal)
+    }
+
+    /// [`G2Surface::split_across`] past the flag: the neighbour's corner normals read.
+    #[cold]
+    #[inline(never)]
+    fn split_of_flagged(&self, tri: usize, k: usize, normal: &[DVec3; 3]) -> Option<Split> {
+        let n = self
+            .topo
+            .neighbour(TriId(tri as u32), k)
+            .expect("blended edges are interior");
+        let [p, q, _] = n.slots.map(usize::from);
+        self.with_local(n.tri.0 as usize, |g| split(normal, &g.normal, k, [p, q]))
+    }
+
     /// `read` of triangle `tri`'s whole net and corner normals, exactly as they were when its
     /// net was stored: kept in this thread's memo from an earlier rebuild when there is one,
     /// which has the same bits (`net_memo`).
@@ -258,7 +282,11 @@ impl<'a> G2Surface<'a> {
     /// block all blend with the same neighbour, or with none).
     ///
     /// Position and tangents are the sums of the pattern module's documentation (Eq. 5 and its
-    /// derivatives); the normal is `∂_u S × ∂_v S`, oriented by the interpolated input normals.
+    /// derivatives); the normal is `∂_u S × ∂_v S`, turned to the side of the input normals
+    /// blended as the surface is ([`Split`]): the own corner normals interpolated,
+    /// `Σ b_c n_c`, where the point blends with nobody or the edge it blends across has no
+    /// split normals (`split` is `None`), and otherwise `(1 − β)·Σ b_c n_c + β·Σ b_c n′_c`,
+    /// `n′` the own corner normals with the shared edge's two corners taking the neighbour's.
     /// Each lane's sums run in the same order whatever `L`, so a lattice block and a single
     /// point agree bit for bit.
     ///
@@ -275,6 +303,7 @@ impl<'a> G2Surface<'a> {
         w: &Lanes<L>,
         own: &N,
         across: Option<&N>,
+        split: Option<&Split>,
         edge_rows: EdgeRows,
     ) -> [SurfacePoint; L] {
         let sums = |rows: &[usize; 7], value_rows: &[usize; 4]| {
@@ -316,11 +345,16 @@ impl<'a> G2Surface<'a> {
             let v = |q: usize| DVec3::new(acc[q][0][l], acc[q][1][l], acc[q][2][l]);
             let (position, du, dv) = (v(0), v(1), v(2));
             let b = w.bary[l];
-            let interpolated = b[0] * normal[0] + b[1] * normal[1] + b[2] * normal[2];
+            let mut interpolated = b[0] * normal[0] + b[1] * normal[1] + b[2] * normal[2];
+            if let Some(d) = split {
+                // `(1 − β)·Σ b_c n_c + β·Σ b_c n′_c`, written as the own side plus the share
+                // of the difference: only the two corners of the edge differ.
+                interpolated += w.beta[l] * (b[0] * d[0] + b[1] * d[1] + b[2] * d[2]);
+            }
             let n = du.cross(dv);
             let len2 = n.length_squared();
             // |N| ≤ 1e-14·|∂_u S|·|∂_v S|: the tangents are parallel to rounding (a degenerate
-            // triangle); fall back to the interpolated input normal.
+            // triangle); fall back to the (blended) interpolated input normal.
             let normal =
                 if len2 > 1e-28 * du.length_squared() * dv.length_squared() && len2.is_finite() {
                     let n = n / len2.sqrt();
@@ -335,6 +369,44 @@ impl<'a> G2Surface<'a> {
             SurfacePoint { position, normal }
         })
     }
+}
+
+/// Where the two triangles of a blended edge carry different input normals at its ends (split
+/// normals): `n′_c − n_c` for each own corner `c`, the neighbour's unit input normal at that
+/// vertex minus the own, 0 at the corner off the edge.
+///
+/// Why the side of a normal needs it: `∂_u S × ∂_v S` fixes the normal's line, and both
+/// triangles of a blended edge find the same line on it (the blend is G¹ there). Each side was
+/// chosen by the own corner normals interpolated; with split normals the two triangles
+/// interpolate different normals along the edge, and where the surface stands near a right
+/// angle to them the two sides fell on opposite sides of it: a 180° turn along the edge.
+/// The side is now chosen by the input normals blended as the surface is (Eq. 5):
+/// `(1 − β)·Σ b_c n_c + β·Σ b_c n′_c`. On the edge `β = ½` from both sides (`t = ½` there, and
+/// `β(½) = ½`) and `b` is the same point, so both sides' references are
+/// `½ Σ b_c (n_c + n′_c)` (to rounding) and choose the same side wherever the surface is not
+/// tangent to it; away from the edge the reference fades into the own interpolation with the
+/// blend, so it is continuous over the triangle and the blended edge, and inside a patch that
+/// folds it still follows the own normals point by point (one sign per piece of triangles
+/// instead removed the turns at edges but broke the normals of folds). Where a triangle's own
+/// normals lie on the other side of the surface than its neighbour's, the side must still
+/// change somewhere between their interiors: it now changes inside the blending region, where
+/// the surface is tangent to the blended normals, instead of along the edge.
+type Split = [DVec3; 3];
+
+/// The [`Split`] across edge `k` whose neighbour holds the own corners `k + 1` and `k + 2` in
+/// its slots `p` and `q`, from the own corner normals `own` and the neighbour's `theirs`;
+/// `None` when they are equal bit for bit, where the reference is the own interpolation and
+/// no arithmetic is added (the output is then that of the own rule, bit for bit).
+#[inline]
+fn split(own: &[DVec3; 3], theirs: &[DVec3; 3], k: usize, [p, q]: [usize; 2]) -> Option<Split> {
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    if theirs[p] == own[i] && theirs[q] == own[j] {
+        return None;
+    }
+    let mut d = [DVec3::ZERO; 3];
+    d[i] = theirs[p] - own[i];
+    d[j] = theirs[q] - own[j];
+    Some(d)
 }
 
 /// Every control point, in slot order: the rows [`G2Surface::combine`] sums by default.
@@ -555,7 +627,7 @@ struct PointEvaluation {
     tri: usize,
     widths: [f64; 3],
     local: Local,
-    across: [Option<SoaNet>; 3],
+    across: [Option<(SoaNet, Option<Split>)>; 3],
 }
 
 impl PointEvaluation {
@@ -578,19 +650,21 @@ impl PointEvaluation {
             };
         }
         let tri = self.tri;
-        let net = w.blended.then(|| {
+        let normal = &self.local.normal;
+        let across = w.blended.then(|| {
             let k = w.k as usize;
             &*self.across[k].get_or_insert_with(|| {
                 let mut net = [[0.0; 10]; 3];
                 surface.across_net(tri, k, Reach::Whole, &mut net);
-                net
+                (net, surface.split_across(tri, k, normal))
             })
         });
         let [p] = G2Surface::combine(
-            &self.local.normal,
+            normal,
             &Lanes::<1>::single(&w),
             &self.local.net,
-            net,
+            across.map(|(net, _)| net),
+            across.and_then(|(_, split)| split.as_ref()),
             EdgeRows::All,
         );
         p
@@ -657,6 +731,8 @@ struct Across {
     /// How much of it was composed.
     reach: Reach,
     net: SoaNet,
+    /// The edge's split normals, if any.
+    split: Option<Split>,
     /// `net` lane by lane, made when a block of two or more lanes first needs it.
     lanes: Option<Broadcast<LANES>>,
 }
@@ -746,23 +822,30 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                             let kept = cached.insert(Across {
                                 reach,
                                 net: [[0.0; 10]; 3],
+                                split: None,
                                 lanes: None,
                             });
                             surface.across_net(*tri, k, reach, &mut kept.net);
+                            kept.split = surface.split_across(*tri, k, &local.normal);
                         }
                     }
                     if !blocks.is_empty() {
                         let own = &*own_lanes.get_or_insert_with(|| broadcast(&local.net));
-                        let across = k.map(|k| {
-                            let a = across[k].as_mut().expect("composed just above");
-                            &*a.lanes.get_or_insert_with(|| broadcast(&a.net))
-                        });
+                        let (across, split) = match k {
+                            Some(k) => {
+                                let a = across[k].as_mut().expect("composed just above");
+                                let lanes = &*a.lanes.get_or_insert_with(|| broadcast(&a.net));
+                                (Some(lanes), a.split.as_ref())
+                            }
+                            None => (None, None),
+                        };
                         for lanes in blocks {
                             let points = G2Surface::combine(
                                 &local.normal,
                                 lanes,
                                 own,
                                 across,
+                                split,
                                 pattern.edge_rows,
                             );
                             for (&target, p) in lanes.target.iter().zip(points) {
@@ -773,13 +856,13 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                         }
                     }
                     if let Some(lane) = single {
-                        let across =
-                            k.map(|k| &across[k].as_ref().expect("composed just above").net);
+                        let across = k.map(|k| across[k].as_ref().expect("composed just above"));
                         let [p] = G2Surface::combine(
                             &local.normal,
                             lane,
                             &local.net,
-                            across,
+                            across.map(|a| &a.net),
+                            across.and_then(|a| a.split.as_ref()),
                             pattern.edge_rows,
                         );
                         out[lane.target[0] as usize] = p;

@@ -52,6 +52,10 @@ pub struct Lanes<const L: usize> {
     pub across: NetWeights<L>,
     /// Barycentrics of each point, for the orientation of its normal.
     pub bary: [[f64; 3]; L],
+    /// The neighbour net's share `β` of each point's blend (Eq. 5), 0 for a point that blends
+    /// with nobody: how far the side its normal is turned to leans on the neighbour's input
+    /// normals (see `G2Surface::combine`).
+    pub beta: [f64; L],
     /// Where each point goes in the output; [`Lanes::PADDING`] for unused lanes.
     pub target: [u32; L],
 }
@@ -65,6 +69,7 @@ impl<const L: usize> Lanes<L> {
             own: [[[0.0; L]; 10]; 3],
             across: [[[0.0; L]; 10]; 3],
             bary: [[0.0; 3]; L],
+            beta: [0.0; L],
             target: [Self::PADDING; L],
         }
     }
@@ -78,6 +83,7 @@ impl<const L: usize> Lanes<L> {
             }
         }
         self.bary[lane] = w.bary;
+        self.beta[lane] = w.beta;
         self.target[lane] = target;
     }
 
@@ -98,6 +104,7 @@ impl Lanes<1> {
             own: lane(&lanes.own),
             across: lane(&lanes.across),
             bary: [lanes.bary[0]],
+            beta: [lanes.beta[0]],
             target: [lanes.target[0]],
         }
     }
@@ -114,6 +121,10 @@ pub struct PointWeights {
     pub k: u8,
     /// Whether it blends at all (`β` or one of its derivatives is not 0).
     pub blended: bool,
+    /// The neighbour net's share `β` of the blend (Eq. 5 with its weights swapped back): 0
+    /// outside the blending regions, exactly ½ on the edge itself (`t = ½` there, and
+    /// `β(½) = ½`), the same from both sides.
+    pub beta: f64,
     /// Weights on the own net, `[quantity][control point]` (see the module documentation).
     pub own: [[f64; 10]; 3],
     /// Weights on the neighbour's net; all zero unless `blended`.
@@ -148,6 +159,7 @@ impl PointWeights {
             corner: corner.map(|c| c as u8),
             k: b.k,
             blended,
+            beta: b.beta,
             own,
             across,
         }
