@@ -4,7 +4,7 @@
 
 use crate::support::*;
 use g2tess::continuity::{self, angle_deg, normal_curvature, Sampling};
-use g2tess::surface::{G2Surface, PnSurface, Profile, Surface, H_MAX};
+use g2tess::surface::{lattice_index, G2Surface, PnSurface, Profile, Surface, H_MAX};
 use g2tess::topology::{EdgeKind, Topology};
 
 /// Positions are sums of ten terms of size ~|p| ≤ 2L: a gap above 1e-13·L is not rounding.
@@ -88,6 +88,81 @@ fn split_normals_stay_watertight_at_h_zero_and_close_for_h_above() {
         );
         let [a, b] = decay(&r);
         assert!(a >= 5.0 && b >= 5.0, "{a} {b} {r:?}");
+    }
+}
+
+/// Two triangles f = ABC and g = BAD in the plane z = 0 meeting at the blended edge AB, with
+/// split normals there that lean 78° from the plane and turn by half a turn from one side to
+/// the other (f: A (1, −1, 0.2), B (−1, −1, 0.2); g: A (−1, 1, 0.2), B (1, 1, 0.2)); C and D
+/// carry +z. The surface stands near a right angle to those normals along AB.
+fn steep_split_edge() -> g2tess::mesh::TriMesh {
+    let v = |x: f64, y: f64, z: f64| glam::DVec3::new(x, y, z);
+    let (a, b, c, d) = (
+        v(0.0, 0.0, 0.0),
+        v(1.0, 0.0, 0.0),
+        v(0.5, 0.9, 0.0),
+        v(0.5, -0.9, 0.0),
+    );
+    let n = |x: f64, y: f64, z: f64| v(x, y, z).normalize();
+    g2tess::mesh::TriMesh {
+        positions: vec![a, b, c, b, a, d],
+        normals: vec![
+            n(1.0, -1.0, 0.2),
+            n(-1.0, -1.0, 0.2),
+            n(0.0, 0.0, 1.0),
+            n(1.0, 1.0, 0.2),
+            n(-1.0, 1.0, 0.2),
+            n(0.0, 0.0, 1.0),
+        ],
+        triangles: vec![[0, 1, 2], [3, 4, 5]],
+    }
+}
+
+/// The side of the normal at a blended edge with split normals is chosen from the input normals
+/// blended as the surface is, the same from both triangles: no 180° turn along the edge.
+///
+/// The mesh is one where each triangle's own interpolated normals pick opposite sides along the
+/// edge (checked here: the rule that used them turned the normal by 180° on this edge). The
+/// positions meet (G0) and the tangent planes agree (G1), as on any blended edge, so the jump
+/// left is the tangent planes' rounding: tangents are sums of 20 terms each within 1e-16 of
+/// their size, a few 1e-14 rad, well below the 1e-6° of the G1 checks above.
+#[test]
+fn split_normals_at_a_steep_blended_edge_keep_one_side() {
+    let mesh = steep_split_edge();
+    let topo = Topology::build(&mesh);
+    let edge = topo.edges().find(|e| e.tris.len() == 2).expect("AB");
+    assert!(edge.kind == EdgeKind::Interior && edge.split_normals);
+    let interpolated =
+        |c: [usize; 2], x: f64| (1.0 - x) * mesh.normals[c[0]] + x * mesh.normals[c[1]];
+    for profile in [Profile::Paper, Profile::C2] {
+        for h in [0.106, 0.212, H_MAX] {
+            let h_s = h_all(&topo, h);
+            let s = G2Surface::new(&mesh, &topo, &h_s, profile);
+            // Point by point, nine samples along the edge.
+            let r = continuity::measure(&s, &topo, &Sampling::default());
+            assert!(r.gap.max <= GAP_TOL, "{h} {profile:?}: {r:?}");
+            assert!(r.normal_jump_deg.max < 1e-6, "{h} {profile:?}: {r:?}");
+            // The lattices: f's edge point (i, 0) is g's (n − i, 0).
+            let n = 16;
+            let (mut on_f, mut on_g) = (Vec::new(), Vec::new());
+            s.evaluate_lattice(0, n, &mut on_f);
+            s.evaluate_lattice(1, n, &mut on_g);
+            let mut opposite = 0;
+            for i in 1..n {
+                let x = f64::from(i) / f64::from(n);
+                let p = on_f[lattice_index(n, i, 0)];
+                let q = on_g[lattice_index(n, n - i, 0)];
+                assert!((p.position - q.position).length() <= GAP_TOL, "{i}");
+                let jump = angle_deg(p.normal, q.normal);
+                assert!(jump < 1e-6, "{h} {profile:?} {i}/{n}: {jump}°");
+                // A (f 0, g 4) at 1 − x, B (f 1, g 3) at x.
+                let own = [interpolated([0, 1], x), interpolated([4, 3], x)];
+                if (p.normal.dot(own[0]) < 0.0) != (p.normal.dot(own[1]) < 0.0) {
+                    opposite += 1;
+                }
+            }
+            assert!(opposite > 0, "{h} {profile:?}: no point of the defect");
+        }
     }
 }
 
