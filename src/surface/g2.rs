@@ -20,6 +20,8 @@ use crate::mesh::TriMesh;
 use crate::sharpness::EffectiveH;
 use crate::topology::{Edge, EdgeId, Topology, TriId};
 
+mod positions;
+
 /// Everything one triangle needs at evaluation time that the mesh and its topology do not
 /// already hold: 88 bytes, one allocation for the whole mesh.
 ///
@@ -649,25 +651,38 @@ impl PointEvaluation {
                 normal: self.local.normal[c],
             };
         }
-        let tri = self.tri;
-        let normal = &self.local.normal;
-        let across = w.blended.then(|| {
-            let k = w.k as usize;
-            &*self.across[k].get_or_insert_with(|| {
-                let mut net = [[0.0; 10]; 3];
-                surface.across_net(tri, k, Reach::Whole, &mut net);
-                (net, surface.split_across(tri, k, normal))
-            })
-        });
+        let (local, across) = self.nets(surface, &w);
         let [p] = G2Surface::combine(
-            normal,
+            &local.normal,
             &Lanes::<1>::single(&w),
-            &self.local.net,
+            &local.net,
             across.map(|(net, _)| net),
             across.and_then(|(_, split)| split.as_ref()),
             EdgeRows::All,
         );
         p
+    }
+
+    /// The set-up's own net and corner normals, and the neighbour's net a point with weights
+    /// `w` blends with, composed on first use.
+    #[inline]
+    fn nets(
+        &mut self,
+        surface: &G2Surface,
+        w: &PointWeights,
+    ) -> (&Local, Option<&(SoaNet, Option<Split>)>) {
+        let tri = self.tri;
+        let normal = &self.local.normal;
+        let across = &mut self.across;
+        let net = w.blended.then(|| {
+            let k = w.k as usize;
+            &*across[k].get_or_insert_with(|| {
+                let mut net = [[0.0; 10]; 3];
+                surface.across_net(tri, k, Reach::Whole, &mut net);
+                (net, surface.split_across(tri, k, normal))
+            })
+        });
+        (&self.local, net)
     }
 }
 
@@ -692,6 +707,35 @@ impl Surface for G2Surface<'_> {
         out: &mut Vec<SurfacePoint>,
     ) {
         PartEvaluation::run(self, tri, &[(level, part)], out);
+    }
+
+    /// The interior through its lattice part's pattern, each edge's positions alone through
+    /// its edge part's ([`positions`]).
+    fn evaluate_lattice_positions_on_edges(
+        &self,
+        tri: usize,
+        level: u32,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        PartEvaluation::set_up(self, tri, false, |evaluation| {
+            evaluation.lattice_with_edge_positions(level, out);
+        });
+    }
+
+    fn evaluate_points_positions_first(
+        &self,
+        tri: usize,
+        barys: &[[f64; 3]],
+        positions_only: usize,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let mut points = PointEvaluation::new(self, tri);
+        let (first, rest) = barys.split_at(positions_only.min(barys.len()));
+        out.extend(first.iter().map(|&bary| SurfacePoint {
+            position: points.position_at(self, bary),
+            normal: DVec3::ZERO,
+        }));
+        out.extend(rest.iter().map(|&bary| points.at(self, bary)));
     }
 
     /// [`Surface::evaluate_lattice_part`] part after part, with the triangle's own net rebuilt
@@ -737,6 +781,91 @@ struct Across {
     lanes: Option<Broadcast<LANES>>,
 }
 
+/// Where [`PartEvaluation::part_into`] puts a part's points: each block of lanes is given its
+/// weights and nets, and computes what it keeps.
+trait PointSink {
+    /// Number of points of the part.
+    fn len(&self) -> usize;
+
+    /// Point `target` of the part, whole.
+    fn put(&mut self, target: u32, point: SurfacePoint);
+
+    /// The points of `lanes` (targets [`Lanes::PADDING`] unused), from `own` and `across` as
+    /// [`G2Surface::combine`] takes them.
+    fn block<const L: usize, N: LaneNet<L>>(
+        &mut self,
+        normal: &[DVec3; 3],
+        lanes: &Lanes<L>,
+        own: &N,
+        across: Option<&N>,
+        split: Option<&Split>,
+        edge_rows: EdgeRows,
+    );
+}
+
+/// Every point whole, in the part's order.
+struct Points<'o>(&'o mut [SurfacePoint]);
+
+impl PointSink for Points<'_> {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    #[inline(always)]
+    fn put(&mut self, target: u32, point: SurfacePoint) {
+        self.0[target as usize] = point;
+    }
+
+    #[inline(always)]
+    fn block<const L: usize, N: LaneNet<L>>(
+        &mut self,
+        normal: &[DVec3; 3],
+        lanes: &Lanes<L>,
+        own: &N,
+        across: Option<&N>,
+        split: Option<&Split>,
+        edge_rows: EdgeRows,
+    ) {
+        let points = G2Surface::combine(normal, lanes, own, across, split, edge_rows);
+        for (&target, p) in lanes.target.iter().zip(points) {
+            if target != Lanes::<1>::PADDING {
+                self.0[target as usize] = p;
+            }
+        }
+    }
+}
+
+/// Makes sure `cached` holds the neighbour's net across edge `k` of `tri` as far as `part`
+/// weighs it: points of edge `k` blend only across edge `k`, and when every part asked for is
+/// an edge only its edge row is composed; any other part may weigh the whole net.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn compose_for(
+    surface: &G2Surface,
+    tri: usize,
+    normal: &[DVec3; 3],
+    cached: &mut Option<Across>,
+    k: usize,
+    part: LatticePart,
+    edges_only: bool,
+) {
+    let reach = if edges_only && part == LatticePart::Edge(k as u8) {
+        Reach::Edge
+    } else {
+        Reach::Whole
+    };
+    if !matches!(cached, Some(had) if had.reach == Reach::Whole || had.reach == reach) {
+        let kept = cached.insert(Across {
+            reach,
+            net: [[0.0; 10]; 3],
+            split: None,
+            lanes: None,
+        });
+        surface.across_net(tri, k, reach, &mut kept.net);
+        kept.split = surface.split_across(tri, k, normal);
+    }
+}
+
 impl<'s, 'a> PartEvaluation<'s, 'a> {
     /// The points of the lattice parts `parts` of triangle `tri`, in order, appended to `out`.
     ///
@@ -751,6 +880,24 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
         parts: &[(u32, LatticePart)],
         out: &mut Vec<SurfacePoint>,
     ) {
+        let edges_only = parts
+            .iter()
+            .all(|&(_, part)| matches!(part, LatticePart::Edge(_)));
+        Self::set_up(surface, tri, edges_only, |evaluation| {
+            for &(level, part) in parts {
+                evaluation.part(level, part, out);
+            }
+        });
+    }
+
+    /// Runs `body` on triangle `tri` set up, made where it is used (see [`PartEvaluation::run`]).
+    #[inline(always)]
+    fn set_up<R>(
+        surface: &'s G2Surface<'a>,
+        tri: usize,
+        edges_only: bool,
+        body: impl FnOnce(&mut Self) -> R,
+    ) -> R {
         let mut evaluation = PartEvaluation {
             surface,
             tri,
@@ -761,19 +908,29 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
             },
             own_lanes: None,
             across: [None, None, None],
-            edges_only: parts
-                .iter()
-                .all(|&(_, part)| matches!(part, LatticePart::Edge(_))),
+            edges_only,
         };
         surface.with_local(tri, |local| evaluation.local = *local);
-        for &(level, part) in parts {
-            evaluation.part(level, part, out);
-        }
+        body(&mut evaluation)
     }
 
     /// The points of `part` of the level-`level` lattice, appended to `out`.
     #[inline]
     fn part(&mut self, level: u32, part: LatticePart, out: &mut Vec<SurfacePoint>) {
+        let base = out.len();
+        out.resize(
+            base + positions::part_len(level, part),
+            SurfacePoint {
+                position: DVec3::ZERO,
+                normal: DVec3::ZERO,
+            },
+        );
+        self.part_into(level, part, &mut Points(&mut out[base..]));
+    }
+
+    /// The points of `part` of the level-`level` lattice, given to `out` block by block.
+    #[inline]
+    fn part_into<S: PointSink>(&mut self, level: u32, part: LatticePart, out: &mut S) {
         let PartEvaluation {
             surface,
             tri,
@@ -786,20 +943,15 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
         surface
             .patterns
             .with(level, part, *widths, surface.profile, |pattern| {
-                let base = out.len();
-                out.resize(
-                    base + pattern.len,
-                    SurfacePoint {
-                        position: DVec3::ZERO,
-                        normal: DVec3::ZERO,
-                    },
-                );
-                let out = &mut out[base..];
+                debug_assert_eq!(out.len(), pattern.len);
                 for &(c, target) in &pattern.corners {
-                    out[target as usize] = SurfacePoint {
-                        position: corner(&local.net, c as usize),
-                        normal: local.normal[c as usize],
-                    };
+                    out.put(
+                        target,
+                        SurfacePoint {
+                            position: corner(&local.net, c as usize),
+                            normal: local.normal[c as usize],
+                        },
+                    );
                 }
                 // The plain points first, then those blended across each edge.
                 for group in [3, 0, 1, 2] {
@@ -809,25 +961,15 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                     }
                     let k = (group < 3).then_some(group);
                     if let Some(k) = k {
-                        // Points of edge k blend only across edge k; any other part may weigh
-                        // the whole net.
-                        let reach = if *edges_only && part == LatticePart::Edge(k as u8) {
-                            Reach::Edge
-                        } else {
-                            Reach::Whole
-                        };
-                        let cached = &mut across[k];
-                        if !matches!(cached, Some(had) if had.reach == Reach::Whole || had.reach == reach)
-                        {
-                            let kept = cached.insert(Across {
-                                reach,
-                                net: [[0.0; 10]; 3],
-                                split: None,
-                                lanes: None,
-                            });
-                            surface.across_net(*tri, k, reach, &mut kept.net);
-                            kept.split = surface.split_across(*tri, k, &local.normal);
-                        }
+                        compose_for(
+                            surface,
+                            *tri,
+                            &local.normal,
+                            &mut across[k],
+                            k,
+                            part,
+                            *edges_only,
+                        );
                     }
                     if !blocks.is_empty() {
                         let own = &*own_lanes.get_or_insert_with(|| broadcast(&local.net));
@@ -840,24 +982,12 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                             None => (None, None),
                         };
                         for lanes in blocks {
-                            let points = G2Surface::combine(
-                                &local.normal,
-                                lanes,
-                                own,
-                                across,
-                                split,
-                                pattern.edge_rows,
-                            );
-                            for (&target, p) in lanes.target.iter().zip(points) {
-                                if target != Lanes::<1>::PADDING {
-                                    out[target as usize] = p;
-                                }
-                            }
+                            out.block(&local.normal, lanes, own, across, split, pattern.edge_rows);
                         }
                     }
                     if let Some(lane) = single {
                         let across = k.map(|k| across[k].as_ref().expect("composed just above"));
-                        let [p] = G2Surface::combine(
+                        out.block(
                             &local.normal,
                             lane,
                             &local.net,
@@ -865,7 +995,6 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
                             across.and_then(|a| a.split.as_ref()),
                             pattern.edge_rows,
                         );
-                        out[lane.target[0] as usize] = p;
                     }
                 }
             });
@@ -918,6 +1047,26 @@ impl Surface for PnSurface<'_> {
 
     fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
         self.0.evaluate_points(tri, barys, out)
+    }
+
+    fn evaluate_lattice_positions_on_edges(
+        &self,
+        tri: usize,
+        level: u32,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        self.0.evaluate_lattice_positions_on_edges(tri, level, out)
+    }
+
+    fn evaluate_points_positions_first(
+        &self,
+        tri: usize,
+        barys: &[[f64; 3]],
+        positions_only: usize,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        self.0
+            .evaluate_points_positions_first(tri, barys, positions_only, out)
     }
 }
 

@@ -149,6 +149,38 @@ pub trait Surface: Sync {
         out.extend(barys.iter().map(|&b| self.evaluate(tri, b)));
     }
 
+    /// [`Surface::evaluate_lattice`] for a caller that reads the normals of the interior points
+    /// only: every position, and the corners' and interior points' normals, are those
+    /// [`Surface::evaluate_lattice`] gives, bit for bit; the normals of the other edge points
+    /// are unspecified (a surface may leave them out: a third of the work of such a point).
+    /// The chord error checks take second differences of positions along the centre point's
+    /// normal, and centres are interior.
+    fn evaluate_lattice_positions_on_edges(
+        &self,
+        tri: usize,
+        level: u32,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        self.evaluate_lattice(tri, level, out);
+    }
+
+    /// [`Surface::evaluate_points`] for a caller that reads only the positions of the first
+    /// `positions_only` points: every position, and the normals from point `positions_only`
+    /// on, are those [`Surface::evaluate_points`] gives, bit for bit; the first points'
+    /// normals are unspecified. The chord error measurement reads its triangles' vertices as
+    /// positions and its samples whole, and asks for both in one call so that a surface sets
+    /// the triangle up once.
+    fn evaluate_points_positions_first(
+        &self,
+        tri: usize,
+        barys: &[[f64; 3]],
+        positions_only: usize,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let _ = positions_only;
+        self.evaluate_points(tri, barys, out);
+    }
+
     /// Some points `(i, j)` of the level-`level` lattice of triangle `tri`, appended to `out` in
     /// the order given; equal to [`Surface::evaluate`] at [`lattice_bary`] bit for bit.
     fn evaluate_lattice_points(

@@ -295,8 +295,14 @@ pub(crate) fn corner_error(
     samples: &mut Samples,
 ) -> PatternError {
     samples.points.clear();
-    surface.evaluate_points(tri, &corners.barys, &mut samples.points);
+    // The vertices are read as positions, the samples whole.
     let on_surface_from = corners.barys.len() - WEIGHTS.len() * corners.triangles.len();
+    surface.evaluate_points_positions_first(
+        tri,
+        &corners.barys,
+        on_surface_from,
+        &mut samples.points,
+    );
     let (vertices, on_surface) = samples.points.split_at(on_surface_from);
     let mut error = PatternError::default();
     for (&(touches, at), on_surface) in corners

@@ -328,7 +328,8 @@ impl ChordErrors {
                     let read = !restored;
                     if read {
                         points.clear();
-                        surface.evaluate_lattice(tri, level, points);
+                        // Second differences are taken along interior points' normals only.
+                        surface.evaluate_lattice_positions_on_edges(tri, level, points);
                         curvature.read(points, level);
                         // At the pattern's own inner level the lattice's interior is the
                         // output's, if the counts stay.

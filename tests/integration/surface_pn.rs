@@ -260,3 +260,80 @@ fn edge_parts_equal_point_evaluation_bit_for_bit() {
         }
     }
 }
+
+/// The bits of a point's coordinates (`==` on floats would take `-0` for `+0`).
+fn bits(p: DVec3) -> [u64; 3] {
+    p.to_array().map(f64::to_bits)
+}
+
+/// The chord error checks read positions alone where they read no normal (a lattice's edge
+/// points, the vertices of the triangles they measure), summed without the tangents: every
+/// position, and every normal they do read, must be what the whole evaluation gives, bit for
+/// bit (the held interiors and the edges the output writes are those points), on split
+/// normals and with some edges at h = 0, at levels with one-lane and two-lane blocks on the
+/// edges. The edge points' normals are left out (zero), so the cheaper sums did run.
+#[test]
+fn positions_alone_equal_the_whole_evaluation_bit_for_bit() {
+    let mut rng = Lcg(31);
+    for mesh in [
+        bumpy_sphere(),
+        reorder(&split_normals(&bumpy_sphere(), 0.5), 0.4, 7).mesh,
+    ] {
+        let topo = Topology::build(&mesh);
+        let h: Vec<f64> = topo
+            .edges()
+            .map(|_| (rng.next() * 4.0).floor() * 0.1)
+            .collect();
+        let h_s = widths(&topo, &h);
+        for profile in [Profile::C2, Profile::Paper] {
+            let s = G2Surface::new(&mesh, &topo, &h_s, profile);
+            for t in 0..mesh.triangles.len() {
+                for level in [2, 3, 6, 7, 13] {
+                    let (mut whole, mut fast) = (Vec::new(), Vec::new());
+                    s.evaluate_lattice(t, level, &mut whole);
+                    s.evaluate_lattice_positions_on_edges(t, level, &mut fast);
+                    assert_eq!(whole.len(), fast.len());
+                    let mut index = 0;
+                    for j in 0..=level {
+                        for i in 0..=level - j {
+                            let (w, f) = (whole[index], fast[index]);
+                            let what = format!("triangle {t} level {level} ({i}, {j})");
+                            assert_eq!(bits(f.position), bits(w.position), "{what}");
+                            let corner =
+                                [i, j, level - i - j].iter().filter(|&&x| x == 0).count() == 2;
+                            let edge = !corner && (i == 0 || j == 0 || i + j == level);
+                            if edge {
+                                assert_eq!(f.normal, DVec3::ZERO, "{what}: the cheap sums ran");
+                            } else {
+                                assert_eq!(bits(f.normal), bits(w.normal), "{what}");
+                            }
+                            index += 1;
+                        }
+                    }
+                }
+                let mut barys = vec![[1.0, 0.0, 0.0], [0.0, 0.5, 0.5], [0.25, 0.0, 0.75]];
+                for _ in 0..12 {
+                    let (u, v) = (rng.next(), rng.next());
+                    let (u, v) = if u + v > 1.0 {
+                        (1.0 - u, 1.0 - v)
+                    } else {
+                        (u, v)
+                    };
+                    barys.push([1.0 - u - v, u, v]);
+                }
+                for first in [0, 5, barys.len()] {
+                    let (mut whole, mut fast) = (Vec::new(), Vec::new());
+                    s.evaluate_points(t, &barys, &mut whole);
+                    s.evaluate_points_positions_first(t, &barys, first, &mut fast);
+                    assert_eq!(whole.len(), fast.len());
+                    for (x, (w, f)) in whole.iter().zip(&fast).enumerate() {
+                        assert_eq!(bits(f.position), bits(w.position), "triangle {t} point {x}");
+                        if x >= first {
+                            assert_eq!(bits(f.normal), bits(w.normal), "triangle {t} point {x}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

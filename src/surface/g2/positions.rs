@@ -1,0 +1,194 @@
+//! Surface points whose normal nobody reads, computed as positions alone: the chord error
+//! checks read a lattice's boundary points and the vertices of the triangles they measure only
+//! as positions (`tessellate/estimate.rs` takes second differences along the normal of the
+//! centre point, `tessellate/chord.rs` measures along the normal of the sample point).
+//!
+//! A position is quantity 0 of the sums of [`G2Surface::combine`] (Eq. 5 with the weights of
+//! the pattern module), summed here alone, over the same control points in the same order, so
+//! it has the bits `combine` gives; the two tangent sums and the normal, two thirds of the
+//! multiplications and the square root, are left out. On an edge part the position weighs
+//! only the edge's boundary curve ([`EdgeRows::EdgeValues`]: four control points of each net
+//! instead of ten), which `combine` already uses for one lane and which leaves its bits as
+//! they are for two (the left-out terms are `±0`, see `combine`).
+
+use glam::DVec3;
+
+use super::{
+    corner, G2Surface, LaneNet, PartEvaluation, PointEvaluation, PointSink, Split, ALL_ROWS,
+};
+use crate::surface::pattern::{
+    EdgeRows, Lanes, NetWeights, PointWeights, EDGE_ROWS, EDGE_VALUE_ROWS,
+};
+use crate::surface::{lattice_index, lattice_len, LatticePart, SurfacePoint};
+
+/// Points of part `part` of the level-`level` lattice (as [`LatticePart::points`] lists them).
+pub(super) fn part_len(level: u32, part: LatticePart) -> usize {
+    let n = level as usize;
+    match part {
+        LatticePart::All => lattice_len(level),
+        LatticePart::Interior => n.saturating_sub(1) * n.saturating_sub(2) / 2,
+        LatticePart::Edge(_) => n.saturating_sub(1),
+    }
+}
+
+/// The control points a position sums for a pattern whose sums need `edge_rows`, in slot order.
+fn value_rows(edge_rows: EdgeRows) -> &'static [usize] {
+    match edge_rows {
+        EdgeRows::All => &ALL_ROWS,
+        EdgeRows::Edge(k) => &EDGE_ROWS[k as usize],
+        EdgeRows::EdgeValues(k) => &EDGE_VALUE_ROWS[k as usize],
+    }
+}
+
+/// Adds the position sums of one net over `rows` to `acc[coordinate][lane]`, term by term as
+/// `accumulate` adds quantity 0.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)] // As in `accumulate`: the form that unrolls into SIMD.
+fn add_values<const L: usize, N: LaneNet<L>>(
+    w: &NetWeights<L>,
+    net: &N,
+    acc: &mut [[f64; L]; 3],
+    rows: &[usize],
+) {
+    for &m in rows {
+        for c in 0..3 {
+            let x = net.lanes(m, c);
+            for l in 0..L {
+                acc[c][l] += w[0][m][l] * x[l];
+            }
+        }
+    }
+}
+
+/// The positions of the `L` points of `w`, on `own` and, when they blend, `across`: the
+/// position [`G2Surface::combine`] gives, bit for bit, for the rows `rows` of
+/// [`value_rows`].
+#[inline(always)]
+fn values<const L: usize, N: LaneNet<L>>(
+    w: &Lanes<L>,
+    own: &N,
+    across: Option<&N>,
+    rows: &[usize],
+) -> [DVec3; L] {
+    let mut acc = [[0.0; L]; 3];
+    add_values(&w.own, own, &mut acc, rows);
+    if let Some(across) = across {
+        add_values(&w.across, across, &mut acc, rows);
+    }
+    std::array::from_fn(|l| DVec3::new(acc[0][l], acc[1][l], acc[2][l]))
+}
+
+/// The positions of one edge part's points, written into a whole lattice at their lattice
+/// index (their normals left as they are).
+struct EdgePositions<'o> {
+    lattice: &'o mut [SurfacePoint],
+    level: u32,
+    k: u8,
+}
+
+impl EdgePositions<'_> {
+    /// The lattice index of the edge part's point `target` (step `target + 1`, see
+    /// [`LatticePart::Edge`]).
+    #[inline]
+    fn slot(&self, target: u32) -> usize {
+        let (n, m) = (self.level, target + 1);
+        let (i, j) = match self.k {
+            0 => (n - m, m),
+            1 => (0, n - m),
+            _ => (m, 0),
+        };
+        lattice_index(n, i, j)
+    }
+}
+
+impl PointSink for EdgePositions<'_> {
+    fn len(&self) -> usize {
+        part_len(self.level, LatticePart::Edge(self.k))
+    }
+
+    #[inline(always)]
+    fn put(&mut self, target: u32, point: SurfacePoint) {
+        let slot = self.slot(target);
+        self.lattice[slot].position = point.position;
+    }
+
+    #[inline(always)]
+    fn block<const L: usize, N: LaneNet<L>>(
+        &mut self,
+        _normal: &[DVec3; 3],
+        lanes: &Lanes<L>,
+        own: &N,
+        across: Option<&N>,
+        _split: Option<&Split>,
+        edge_rows: EdgeRows,
+    ) {
+        let positions = values(lanes, own, across, value_rows(edge_rows));
+        for (&target, p) in lanes.target.iter().zip(positions) {
+            if target != Lanes::<1>::PADDING {
+                let slot = self.slot(target);
+                self.lattice[slot].position = p;
+            }
+        }
+    }
+}
+
+impl PartEvaluation<'_, '_> {
+    /// The whole level-`level` lattice in lattice order, appended to `out`: the interior points
+    /// and the corners as [`crate::surface::Surface::evaluate_lattice`] gives them, the edge
+    /// points' positions as it gives them and their normals zero.
+    pub(super) fn lattice_with_edge_positions(&mut self, level: u32, out: &mut Vec<SurfacePoint>) {
+        let zero = SurfacePoint {
+            position: DVec3::ZERO,
+            normal: DVec3::ZERO,
+        };
+        let base = out.len();
+        let interior = part_len(level, LatticePart::Interior);
+        let len = lattice_len(level);
+        out.resize(base + len + interior, zero);
+        let (lattice, inside) = out[base..].split_at_mut(len);
+        // The interior evaluated whole after the lattice, then moved into its rows.
+        self.part_into(level, LatticePart::Interior, &mut super::Points(inside));
+        let mut next = inside.iter();
+        for j in 1..level {
+            let start = lattice_index(level, 1, j);
+            for (slot, p) in lattice[start..start + (level - 1 - j) as usize]
+                .iter_mut()
+                .zip(&mut next)
+            {
+                *slot = *p;
+            }
+        }
+        for (c, (i, j)) in [(0, 0), (level, 0), (0, level)].into_iter().enumerate() {
+            lattice[lattice_index(level, i, j)] = SurfacePoint {
+                position: corner(&self.local.net, c),
+                normal: self.local.normal[c],
+            };
+        }
+        for k in (0..3).filter(|_| level >= 2) {
+            self.part_into(
+                level,
+                LatticePart::Edge(k),
+                &mut EdgePositions {
+                    lattice: &mut *lattice,
+                    level,
+                    k,
+                },
+            );
+        }
+        out.truncate(base + len);
+    }
+}
+
+impl PointEvaluation {
+    /// The position [`PointEvaluation::at`] gives at `bary`, bit for bit, without its normal.
+    pub(super) fn position_at(&mut self, surface: &G2Surface, bary: [f64; 3]) -> DVec3 {
+        let w = PointWeights::at(bary, self.widths, surface.profile);
+        if let Some(c) = w.corner {
+            return corner(&self.local.net, c as usize);
+        }
+        let (local, across) = self.nets(surface, &w);
+        let net = across.map(|(net, _)| net);
+        let [p] = values(&Lanes::<1>::single(&w), &local.net, net, &ALL_ROWS);
+        p
+    }
+}
