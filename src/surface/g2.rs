@@ -12,7 +12,8 @@ use super::neighbour_net::{compose_across, Reach, SoaNet};
 use super::net_memo::{self, Local};
 use super::nets::Nets;
 use super::pattern::{
-    EdgeRows, Lanes, NetWeights, PatternCache, PointWeights, EDGE_ROWS, EDGE_VALUE_ROWS, LANES,
+    EdgeRows, Lanes, NetWeights, Pattern, PatternCache, PointWeights, EDGE_ROWS, EDGE_VALUE_ROWS,
+    LANES,
 };
 use super::pn::{Net, B111, NEAR};
 use super::{LatticePart, Profile, Surface, SurfacePoint};
@@ -20,6 +21,7 @@ use crate::mesh::TriMesh;
 use crate::sharpness::EffectiveH;
 use crate::topology::{Edge, EdgeId, Topology, TriId};
 
+mod point_sets;
 mod positions;
 
 /// Everything one triangle needs at evaluation time that the mesh and its topology do not
@@ -127,6 +129,8 @@ pub struct G2Surface<'a> {
     patches: Vec<Patch>,
     profile: Profile,
     patterns: PatternCache,
+    /// The weights of the scattered point sets asked for again and again ([`point_sets`]).
+    point_sets: point_sets::PointSets,
     /// This surface's tag in the per-thread memo of rebuilt nets ([`net_memo`]).
     memo_owner: u64,
 }
@@ -186,6 +190,7 @@ impl<'a> G2Surface<'a> {
             patches,
             profile,
             patterns: PatternCache::default(),
+            point_sets: point_sets::PointSets::new(point_sets::MAX_SETS),
             memo_owner: net_memo::new_owner(),
         };
         debug_assert!((0..mesh.triangles.len()).all(|t| (0..3)
@@ -729,8 +734,12 @@ impl Surface for G2Surface<'_> {
         positions_only: usize,
         out: &mut Vec<SurfacePoint>,
     ) {
+        let positions_only = positions_only.min(barys.len());
+        if self.point_set(tri, barys, positions_only, out) {
+            return;
+        }
         let mut points = PointEvaluation::new(self, tri);
-        let (first, rest) = barys.split_at(positions_only.min(barys.len()));
+        let (first, rest) = barys.split_at(positions_only);
         out.extend(first.iter().map(|&bary| SurfacePoint {
             position: points.position_at(self, bary),
             normal: DVec3::ZERO,
@@ -931,73 +940,80 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
     /// The points of `part` of the level-`level` lattice, given to `out` block by block.
     #[inline]
     fn part_into<S: PointSink>(&mut self, level: u32, part: LatticePart, out: &mut S) {
+        let surface = self.surface;
+        surface
+            .patterns
+            .with(level, part, self.widths, surface.profile, |pattern| {
+                self.pattern_into(pattern, part, out)
+            });
+    }
+
+    /// The points of `pattern`, the pattern of `part`, given to `out` block by block.
+    #[inline(always)]
+    fn pattern_into<S: PointSink>(&mut self, pattern: &Pattern, part: LatticePart, out: &mut S) {
         let PartEvaluation {
             surface,
             tri,
-            widths,
+            widths: _,
             local,
             own_lanes,
             across,
             edges_only,
         } = self;
-        surface
-            .patterns
-            .with(level, part, *widths, surface.profile, |pattern| {
-                debug_assert_eq!(out.len(), pattern.len);
-                for &(c, target) in &pattern.corners {
-                    out.put(
-                        target,
-                        SurfacePoint {
-                            position: corner(&local.net, c as usize),
-                            normal: local.normal[c as usize],
-                        },
-                    );
+        debug_assert_eq!(out.len(), pattern.len);
+        for &(c, target) in &pattern.corners {
+            out.put(
+                target,
+                SurfacePoint {
+                    position: corner(&local.net, c as usize),
+                    normal: local.normal[c as usize],
+                },
+            );
+        }
+        // The plain points first, then those blended across each edge.
+        for group in [3, 0, 1, 2] {
+            let (blocks, single) = pattern.group(group);
+            if blocks.is_empty() && single.is_none() {
+                continue;
+            }
+            let k = (group < 3).then_some(group);
+            if let Some(k) = k {
+                compose_for(
+                    surface,
+                    *tri,
+                    &local.normal,
+                    &mut across[k],
+                    k,
+                    part,
+                    *edges_only,
+                );
+            }
+            if !blocks.is_empty() {
+                let own = &*own_lanes.get_or_insert_with(|| broadcast(&local.net));
+                let (across, split) = match k {
+                    Some(k) => {
+                        let a = across[k].as_mut().expect("composed just above");
+                        let lanes = &*a.lanes.get_or_insert_with(|| broadcast(&a.net));
+                        (Some(lanes), a.split.as_ref())
+                    }
+                    None => (None, None),
+                };
+                for lanes in blocks {
+                    out.block(&local.normal, lanes, own, across, split, pattern.edge_rows);
                 }
-                // The plain points first, then those blended across each edge.
-                for group in [3, 0, 1, 2] {
-                    let (blocks, single) = pattern.group(group);
-                    if blocks.is_empty() && single.is_none() {
-                        continue;
-                    }
-                    let k = (group < 3).then_some(group);
-                    if let Some(k) = k {
-                        compose_for(
-                            surface,
-                            *tri,
-                            &local.normal,
-                            &mut across[k],
-                            k,
-                            part,
-                            *edges_only,
-                        );
-                    }
-                    if !blocks.is_empty() {
-                        let own = &*own_lanes.get_or_insert_with(|| broadcast(&local.net));
-                        let (across, split) = match k {
-                            Some(k) => {
-                                let a = across[k].as_mut().expect("composed just above");
-                                let lanes = &*a.lanes.get_or_insert_with(|| broadcast(&a.net));
-                                (Some(lanes), a.split.as_ref())
-                            }
-                            None => (None, None),
-                        };
-                        for lanes in blocks {
-                            out.block(&local.normal, lanes, own, across, split, pattern.edge_rows);
-                        }
-                    }
-                    if let Some(lane) = single {
-                        let across = k.map(|k| across[k].as_ref().expect("composed just above"));
-                        out.block(
-                            &local.normal,
-                            lane,
-                            &local.net,
-                            across.map(|a| &a.net),
-                            across.and_then(|a| a.split.as_ref()),
-                            pattern.edge_rows,
-                        );
-                    }
-                }
-            });
+            }
+            if let Some(lane) = single {
+                let across = k.map(|k| across[k].as_ref().expect("composed just above"));
+                out.block(
+                    &local.normal,
+                    lane,
+                    &local.net,
+                    across.map(|a| &a.net),
+                    across.and_then(|a| a.split.as_ref()),
+                    pattern.edge_rows,
+                );
+            }
+        }
     }
 }
 

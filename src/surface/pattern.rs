@@ -236,6 +236,32 @@ const fn rows_up_to<const N: usize>(most: usize) -> [[usize; N]; 3] {
 impl Pattern {
     /// Computes the pattern of `part` of the level-`n` lattice (`n ≥ 1`).
     pub fn new(n: u32, part: LatticePart, h: [f64; 3], profile: Profile) -> Pattern {
+        let points = part.points(n);
+        let barys = points.iter().map(|&(i, j)| lattice_bary(n, i, j));
+        Pattern::build(barys, points.len(), part, h, profile)
+    }
+
+    /// The pattern of the points at barycentrics `barys`, in their order (targets `0..len`),
+    /// for a set of scattered points asked for on many triangles: the same weights as at a
+    /// lattice's points, so its sums equal [`PointWeights::at`]'s evaluated one by one.
+    pub fn at_points(barys: &[[f64; 3]], h: [f64; 3], profile: Profile) -> Pattern {
+        Pattern::build(
+            barys.iter().copied(),
+            barys.len(),
+            LatticePart::All,
+            h,
+            profile,
+        )
+    }
+
+    /// The pattern of the `len` points `barys`, which are `part`'s (for the edge rows).
+    fn build(
+        barys: impl Iterator<Item = [f64; 3]>,
+        len: usize,
+        part: LatticePart,
+        h: [f64; 3],
+        profile: Profile,
+    ) -> Pattern {
         let mut pattern = Pattern {
             len: 0,
             corners: Vec::new(),
@@ -246,10 +272,9 @@ impl Pattern {
         };
         // Lanes filled so far in the last block of each group.
         let mut filled = [LANES; 4];
-        let points = part.points(n);
-        for (target, &(i, j)) in points.iter().enumerate() {
+        for (target, bary) in barys.enumerate() {
             let target = target as u32;
-            let w = PointWeights::at(lattice_bary(n, i, j), h, profile);
+            let w = PointWeights::at(bary, h, profile);
             if let Some(c) = w.corner {
                 pattern.corners.push((c, target));
                 continue;
@@ -267,7 +292,7 @@ impl Pattern {
             last.set(filled[group], &w, target);
             filled[group] += 1;
         }
-        pattern.len = points.len();
+        pattern.len = len;
         if let LatticePart::Edge(k) = part {
             // Whether every weight of quantities `quantities` is zero on the control points
             // whose exponent of `λ_k` is at least `from`, in every block, on both nets.

@@ -78,38 +78,35 @@ fn values<const L: usize, N: LaneNet<L>>(
     std::array::from_fn(|l| DVec3::new(acc[0][l], acc[1][l], acc[2][l]))
 }
 
-/// The positions of one edge part's points, written into a whole lattice at their lattice
-/// index (their normals left as they are).
-struct EdgePositions<'o> {
-    lattice: &'o mut [SurfacePoint],
-    level: u32,
-    k: u8,
+/// The positions of a part's `len` points, written into `out` at `slot(target)` (their
+/// normals left as they are).
+pub(super) struct Positions<'o, F> {
+    pub out: &'o mut [SurfacePoint],
+    pub len: usize,
+    pub slot: F,
 }
 
-impl EdgePositions<'_> {
-    /// The lattice index of the edge part's point `target` (step `target + 1`, see
-    /// [`LatticePart::Edge`]).
-    #[inline]
-    fn slot(&self, target: u32) -> usize {
-        let (n, m) = (self.level, target + 1);
-        let (i, j) = match self.k {
-            0 => (n - m, m),
-            1 => (0, n - m),
-            _ => (m, 0),
-        };
-        lattice_index(n, i, j)
-    }
+/// The lattice index of edge `k`'s point `target` of the level-`n` lattice (step
+/// `target + 1`, see [`LatticePart::Edge`]).
+#[inline]
+fn edge_slot(n: u32, k: u8, target: u32) -> usize {
+    let m = target + 1;
+    let (i, j) = match k {
+        0 => (n - m, m),
+        1 => (0, n - m),
+        _ => (m, 0),
+    };
+    lattice_index(n, i, j)
 }
 
-impl PointSink for EdgePositions<'_> {
+impl<F: Fn(u32) -> usize> PointSink for Positions<'_, F> {
     fn len(&self) -> usize {
-        part_len(self.level, LatticePart::Edge(self.k))
+        self.len
     }
 
     #[inline(always)]
     fn put(&mut self, target: u32, point: SurfacePoint) {
-        let slot = self.slot(target);
-        self.lattice[slot].position = point.position;
+        self.out[(self.slot)(target)].position = point.position;
     }
 
     #[inline(always)]
@@ -125,8 +122,7 @@ impl PointSink for EdgePositions<'_> {
         let positions = values(lanes, own, across, value_rows(edge_rows));
         for (&target, p) in lanes.target.iter().zip(positions) {
             if target != Lanes::<1>::PADDING {
-                let slot = self.slot(target);
-                self.lattice[slot].position = p;
+                self.out[(self.slot)(target)].position = p;
             }
         }
     }
@@ -168,10 +164,10 @@ impl PartEvaluation<'_, '_> {
             self.part_into(
                 level,
                 LatticePart::Edge(k),
-                &mut EdgePositions {
-                    lattice: &mut *lattice,
-                    level,
-                    k,
+                &mut Positions {
+                    out: &mut *lattice,
+                    len: part_len(level, LatticePart::Edge(k)),
+                    slot: |target| edge_slot(level, k, target),
                 },
             );
         }
