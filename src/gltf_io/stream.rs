@@ -313,6 +313,12 @@ fn release_arrays(doc: &mut Document) {
 /// Hands each piece of `bin` to `put`, in order, and frees it as soon as it is written, on a
 /// pool thread: unmapping a large array's pages (about 30 ms for a 112 MB output, measured)
 /// then runs beside the next write and the flush to disk instead of after the rename.
+///
+/// The pieces are written by one thread, unlike the parallel read of an input: a buffered
+/// write holds its file's inode lock exclusively while it copies into the page cache (ext4,
+/// XFS and tmpfs alike), so blocks written at their offsets by several threads are copied one
+/// after another, the other threads asleep on the lock. Copying in parallel through a shared
+/// mapping would turn a full disk into a signal instead of an error naming the file.
 fn put_and_free(bin: Pieces, mut put: impl FnMut(&[u8]) -> Result<()>) -> Result<()> {
     for piece in bin.into_pieces() {
         put(piece.as_bytes())?;
