@@ -715,7 +715,7 @@ impl Surface for G2Surface<'_> {
     }
 
     /// The interior through its lattice part's pattern, each edge's positions alone through
-    /// its edge part's ([`positions`]).
+    /// its edge part's (`g2::positions`).
     fn evaluate_lattice_positions_on_edges(
         &self,
         tri: usize,
