@@ -928,7 +928,7 @@ impl<'s, 'a> PartEvaluation<'s, 'a> {
     fn part(&mut self, level: u32, part: LatticePart, out: &mut Vec<SurfacePoint>) {
         let base = out.len();
         out.resize(
-            base + positions::part_len(level, part),
+            base + part.len(level),
             SurfacePoint {
                 position: DVec3::ZERO,
                 normal: DVec3::ZERO,

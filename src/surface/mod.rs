@@ -229,6 +229,19 @@ impl LatticePart {
                 .collect(),
         }
     }
+
+    /// Number of the part's points of the level-`n` lattice: `(n + 1)(n + 2)/2` in all,
+    /// `(n − 1)(n − 2)/2` inside, `n − 1` on an edge (corners excluded); `points(n).len()`
+    /// without listing them.
+    #[inline]
+    pub fn len(self, n: u32) -> usize {
+        let m = n as usize;
+        match self {
+            LatticePart::All => lattice_len(n),
+            LatticePart::Interior => m.saturating_sub(1) * m.saturating_sub(2) / 2,
+            LatticePart::Edge(_) => m.saturating_sub(1),
+        }
+    }
 }
 
 /// Index of lattice point `(i, j)` of level `n`. Lattice order, used by every module: for `j` in

@@ -64,7 +64,7 @@ impl<'a> TriangleWriter<'a> {
         let mut start = 0;
         for &(level, part) in parts {
             self.batch_parts.push((level, part, start));
-            start += part_len(level, part);
+            start += part.len(level);
         }
         debug_assert_eq!(start, self.batch.len());
     }
@@ -232,17 +232,6 @@ impl<'a> TriangleWriter<'a> {
 #[inline]
 pub(super) fn edge_slot(first_slot: usize, ascending: bool, n: u32, m: u32) -> usize {
     first_slot + (if ascending { m } else { n - m } - 1) as usize
-}
-
-/// Points in `part` of the level-`level` lattice (see [`LatticePart::points`]).
-#[inline]
-fn part_len(level: u32, part: LatticePart) -> usize {
-    let n = level as usize;
-    match part {
-        LatticePart::All => (n + 1) * (n + 2) / 2,
-        LatticePart::Interior => n.saturating_sub(1) * n.saturating_sub(2) / 2,
-        LatticePart::Edge(_) => n.saturating_sub(1),
-    }
 }
 
 /// `triangles` by local point, written as output slots through `local`.

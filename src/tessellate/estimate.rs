@@ -27,7 +27,7 @@ use glam::DVec3;
 
 use super::chord::WEIGHTS;
 use super::transition::{Pattern, PatternKey};
-use crate::surface::{lattice_index, SurfacePoint};
+use crate::surface::{lattice_index, LatticePart, SurfacePoint};
 
 /// Second differences of a level-`L` lattice at its interior points (`i, j ≥ 1`, `i + j < L`),
 /// along the surface normal there, in interior lattice order: along `i`, along `j`, and along
@@ -85,7 +85,7 @@ impl Curvature {
     /// level) and the spread; whether it did. A lattice of the same triangle and level has the
     /// same values, bit for bit, so restoring them stands for reading it again.
     pub fn restore(&mut self, level: u32, values: &[[f64; 3]]) -> bool {
-        let interior = (level.saturating_sub(1) * level.saturating_sub(2) / 2) as usize;
+        let interior = LatticePart::Interior.len(level);
         if level < 3 || values.len() != interior + 1 {
             return false;
         }

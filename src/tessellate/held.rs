@@ -23,7 +23,7 @@ use std::sync::Mutex;
 
 use super::blocks::Block;
 use super::VertexSource;
-use crate::surface::{lattice_index, SurfacePoint};
+use crate::surface::{lattice_index, LatticePart, SurfacePoint};
 
 /// The most memory the held interiors may take (about 2.8M points): past it a triangle's
 /// interior is evaluated again at the write. The 10k icosphere at the error level 16 reaches
@@ -61,7 +61,7 @@ impl Holding {
     /// order, in place of what `tri` held before (a lattice of a lower inner level, which the
     /// output will not use), when it fits.
     pub fn offer(&self, tri: usize, level: u32, points: &[SurfacePoint]) {
-        let len = (level.saturating_sub(1) * level.saturating_sub(2) / 2) as usize;
+        let len = LatticePart::Interior.len(level);
         let bytes = len * std::mem::size_of::<HeldPoint>();
         let fits = |held: &HeldInteriors| self.held_after(held, tri, bytes);
         if len == 0 || fits(&self.held.lock().expect("no check panics while holding")).is_none() {

@@ -3,6 +3,7 @@
 //! flipping triangles does not move the surface.
 
 use crate::support::*;
+use g2tess::mesh::TriMesh;
 use g2tess::sharpness::EffectiveH;
 use g2tess::surface::{
     lattice_bary, G2Surface, LatticePart, Nets, PnSurface, Profile, Surface, H_MAX,
@@ -224,7 +225,34 @@ fn h_is_clamped_and_unblendable_edges_are_reported() {
 /// as stored) and with some edges at h = 0 (plain points on an edge), in every corner order.
 #[test]
 fn edge_parts_equal_point_evaluation_bit_for_bit() {
-    let mut rng = Lcg(29);
+    random_h_surfaces(&mut Lcg(29), |s, mesh, _| {
+        for level in [2, 3, 6] {
+            for t in 0..mesh.triangles.len() {
+                let parts: Vec<_> = (0..3).map(|k| (level, LatticePart::Edge(k))).collect();
+                let mut together = Vec::new();
+                s.evaluate_lattice_parts(t, &parts, &mut together);
+                let mut want = Vec::new();
+                for &(_, part) in &parts {
+                    let mut alone = Vec::new();
+                    s.evaluate_lattice_part(t, level, part, &mut alone);
+                    let points: Vec<_> = part
+                        .points(level)
+                        .iter()
+                        .map(|&(i, j)| s.evaluate(t, lattice_bary(level, i, j)))
+                        .collect();
+                    assert_eq!(alone, points, "triangle {t} level {level} {part:?}");
+                    want.extend(points);
+                }
+                assert_eq!(together, want, "triangle {t} level {level}");
+            }
+        }
+    });
+}
+
+/// Runs `body` on each G² surface the bit-for-bit tests compare two paths on: the bumpy
+/// sphere as it is and with split normals, reordered, each edge a random h in {0, 0.1, 0.2,
+/// 0.3} (some unblended), with both profiles.
+fn random_h_surfaces(rng: &mut Lcg, mut body: impl FnMut(&G2Surface, &TriMesh, &mut Lcg)) {
     for mesh in [
         bumpy_sphere(),
         reorder(&split_normals(&bumpy_sphere(), 0.5), 0.4, 7).mesh,
@@ -236,27 +264,7 @@ fn edge_parts_equal_point_evaluation_bit_for_bit() {
             .collect();
         let h_s = widths(&topo, &h);
         for profile in [Profile::C2, Profile::Paper] {
-            let s = G2Surface::new(&mesh, &topo, &h_s, profile);
-            for level in [2, 3, 6] {
-                for t in 0..mesh.triangles.len() {
-                    let parts: Vec<_> = (0..3).map(|k| (level, LatticePart::Edge(k))).collect();
-                    let mut together = Vec::new();
-                    s.evaluate_lattice_parts(t, &parts, &mut together);
-                    let mut want = Vec::new();
-                    for &(_, part) in &parts {
-                        let mut alone = Vec::new();
-                        s.evaluate_lattice_part(t, level, part, &mut alone);
-                        let points: Vec<_> = part
-                            .points(level)
-                            .iter()
-                            .map(|&(i, j)| s.evaluate(t, lattice_bary(level, i, j)))
-                            .collect();
-                        assert_eq!(alone, points, "triangle {t} level {level} {part:?}");
-                        want.extend(points);
-                    }
-                    assert_eq!(together, want, "triangle {t} level {level}");
-                }
-            }
+            body(&G2Surface::new(&mesh, &topo, &h_s, profile), &mesh, rng);
         }
     }
 }
@@ -274,78 +282,64 @@ fn bits(p: DVec3) -> [u64; 3] {
 /// edges. The edge points' normals are left out (zero), so the cheaper sums did run.
 #[test]
 fn positions_alone_equal_the_whole_evaluation_bit_for_bit() {
-    let mut rng = Lcg(31);
-    for mesh in [
-        bumpy_sphere(),
-        reorder(&split_normals(&bumpy_sphere(), 0.5), 0.4, 7).mesh,
-    ] {
-        let topo = Topology::build(&mesh);
-        let h: Vec<f64> = topo
-            .edges()
-            .map(|_| (rng.next() * 4.0).floor() * 0.1)
-            .collect();
-        let h_s = widths(&topo, &h);
-        for profile in [Profile::C2, Profile::Paper] {
-            let s = G2Surface::new(&mesh, &topo, &h_s, profile);
-            for t in 0..mesh.triangles.len() {
-                for level in [2, 3, 6, 7, 13] {
-                    let (mut whole, mut fast) = (Vec::new(), Vec::new());
-                    s.evaluate_lattice(t, level, &mut whole);
-                    s.evaluate_lattice_positions_on_edges(t, level, &mut fast);
-                    assert_eq!(whole.len(), fast.len());
-                    let mut index = 0;
-                    for j in 0..=level {
-                        for i in 0..=level - j {
-                            let (w, f) = (whole[index], fast[index]);
-                            let what = format!("triangle {t} level {level} ({i}, {j})");
-                            assert_eq!(bits(f.position), bits(w.position), "{what}");
-                            let corner =
-                                [i, j, level - i - j].iter().filter(|&&x| x == 0).count() == 2;
-                            let edge = !corner && (i == 0 || j == 0 || i + j == level);
-                            if edge {
-                                assert_eq!(f.normal, DVec3::ZERO, "{what}: the cheap sums ran");
-                            } else {
-                                assert_eq!(bits(f.normal), bits(w.normal), "{what}");
-                            }
-                            index += 1;
+    random_h_surfaces(&mut Lcg(31), |s, mesh, rng| {
+        for t in 0..mesh.triangles.len() {
+            for level in [2, 3, 6, 7, 13] {
+                let (mut whole, mut fast) = (Vec::new(), Vec::new());
+                s.evaluate_lattice(t, level, &mut whole);
+                s.evaluate_lattice_positions_on_edges(t, level, &mut fast);
+                assert_eq!(whole.len(), fast.len());
+                let mut index = 0;
+                for j in 0..=level {
+                    for i in 0..=level - j {
+                        let (w, f) = (whole[index], fast[index]);
+                        let what = format!("triangle {t} level {level} ({i}, {j})");
+                        assert_eq!(bits(f.position), bits(w.position), "{what}");
+                        let corner = [i, j, level - i - j].iter().filter(|&&x| x == 0).count() == 2;
+                        let edge = !corner && (i == 0 || j == 0 || i + j == level);
+                        if edge {
+                            assert_eq!(f.normal, DVec3::ZERO, "{what}: the cheap sums ran");
+                        } else {
+                            assert_eq!(bits(f.normal), bits(w.normal), "{what}");
                         }
+                        index += 1;
                     }
                 }
-                let mut barys = vec![[1.0, 0.0, 0.0], [0.0, 0.5, 0.5], [0.25, 0.0, 0.75]];
-                for _ in 0..12 {
-                    let (u, v) = (rng.next(), rng.next());
-                    let (u, v) = if u + v > 1.0 {
-                        (1.0 - u, 1.0 - v)
-                    } else {
-                        (u, v)
-                    };
-                    barys.push([1.0 - u - v, u, v]);
-                }
-                // A set asked for on every triangle, whose weights the surface keeps, and sets
-                // of their own.
-                let fixed: Vec<[f64; 3]> = (0..40)
-                    .map(|x| {
-                        let (u, v) = (f64::from(x % 7) / 9.0, f64::from(x / 7) / 8.0);
-                        [1.0 - u - v, u, v]
-                    })
-                    .collect();
-                for (set, first) in [(&fixed, 12), (&fixed, 12), (&barys, 0), (&barys, 5)]
-                    .into_iter()
-                    .chain([(&barys, barys.len())])
-                {
-                    let barys = set;
-                    let (mut whole, mut fast) = (Vec::new(), Vec::new());
-                    s.evaluate_points(t, barys, &mut whole);
-                    s.evaluate_points_positions_first(t, barys, first, &mut fast);
-                    assert_eq!(whole.len(), fast.len());
-                    for (x, (w, f)) in whole.iter().zip(&fast).enumerate() {
-                        assert_eq!(bits(f.position), bits(w.position), "triangle {t} point {x}");
-                        if x >= first {
-                            assert_eq!(bits(f.normal), bits(w.normal), "triangle {t} point {x}");
-                        }
+            }
+            let mut barys = vec![[1.0, 0.0, 0.0], [0.0, 0.5, 0.5], [0.25, 0.0, 0.75]];
+            for _ in 0..12 {
+                let (u, v) = (rng.next(), rng.next());
+                let (u, v) = if u + v > 1.0 {
+                    (1.0 - u, 1.0 - v)
+                } else {
+                    (u, v)
+                };
+                barys.push([1.0 - u - v, u, v]);
+            }
+            // A set asked for on every triangle, whose weights the surface keeps, and sets
+            // of their own.
+            let fixed: Vec<[f64; 3]> = (0..40)
+                .map(|x| {
+                    let (u, v) = (f64::from(x % 7) / 9.0, f64::from(x / 7) / 8.0);
+                    [1.0 - u - v, u, v]
+                })
+                .collect();
+            for (set, first) in [(&fixed, 12), (&fixed, 12), (&barys, 0), (&barys, 5)]
+                .into_iter()
+                .chain([(&barys, barys.len())])
+            {
+                let barys = set;
+                let (mut whole, mut fast) = (Vec::new(), Vec::new());
+                s.evaluate_points(t, barys, &mut whole);
+                s.evaluate_points_positions_first(t, barys, first, &mut fast);
+                assert_eq!(whole.len(), fast.len());
+                for (x, (w, f)) in whole.iter().zip(&fast).enumerate() {
+                    assert_eq!(bits(f.position), bits(w.position), "triangle {t} point {x}");
+                    if x >= first {
+                        assert_eq!(bits(f.normal), bits(w.normal), "triangle {t} point {x}");
                     }
                 }
             }
         }
-    }
+    });
 }

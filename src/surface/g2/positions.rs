@@ -21,16 +21,6 @@ use crate::surface::pattern::{
 };
 use crate::surface::{lattice_index, lattice_len, LatticePart, SurfacePoint};
 
-/// Points of part `part` of the level-`level` lattice (as [`LatticePart::points`] lists them).
-pub(super) fn part_len(level: u32, part: LatticePart) -> usize {
-    let n = level as usize;
-    match part {
-        LatticePart::All => lattice_len(level),
-        LatticePart::Interior => n.saturating_sub(1) * n.saturating_sub(2) / 2,
-        LatticePart::Edge(_) => n.saturating_sub(1),
-    }
-}
-
 /// The control points a position sums for a pattern whose sums need `edge_rows`, in slot order.
 fn value_rows(edge_rows: EdgeRows) -> &'static [usize] {
     match edge_rows {
@@ -138,7 +128,7 @@ impl PartEvaluation<'_, '_> {
             normal: DVec3::ZERO,
         };
         let base = out.len();
-        let interior = part_len(level, LatticePart::Interior);
+        let interior = LatticePart::Interior.len(level);
         let len = lattice_len(level);
         out.resize(base + len + interior, zero);
         let (lattice, inside) = out[base..].split_at_mut(len);
@@ -166,7 +156,7 @@ impl PartEvaluation<'_, '_> {
                 LatticePart::Edge(k),
                 &mut Positions {
                     out: &mut *lattice,
-                    len: part_len(level, LatticePart::Edge(k)),
+                    len: LatticePart::Edge(k).len(level),
                     slot: |target| edge_slot(level, k, target),
                 },
             );
