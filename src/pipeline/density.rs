@@ -8,6 +8,7 @@
 use std::ops::Range;
 use std::sync::Mutex;
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::mesh::TriMesh;
@@ -206,16 +207,34 @@ impl Density {
 }
 
 /// Length of the diagonal of the bounding box of `mesh`'s positions.
+///
+/// Folded in parallel blocks: on a million vertices a fold on one thread took about 2 ms at the
+/// end of each mesh with the other threads idle. The bounds are the same whatever the blocks:
+/// every block starts from the first position (one of the positions, so it moves no bound),
+/// the componentwise minimum and maximum pick one of their operands and skip a NaN whichever
+/// side it is on, and a bound that is +0 in one order and −0 in another changes no difference
+/// `hi − lo` it enters.
 pub(super) fn diagonal(mesh: &TriMesh) -> f64 {
     let Some(&first) = mesh.positions.first() else {
         return 0.0;
     };
     let (lo, hi) = mesh
         .positions
-        .iter()
-        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        .par_chunks(DIAGONAL_BLOCK)
+        .map(|block| {
+            block
+                .iter()
+                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+        })
+        .reduce(
+            || (first, first),
+            |(lo, hi), (block_lo, block_hi)| (lo.min(block_lo), hi.max(block_hi)),
+        );
     (hi - lo).length()
 }
+
+/// Positions one task of [`diagonal`] folds.
+const DIAGONAL_BLOCK: usize = 1 << 16;
 
 /// Smallest angle (degrees) and largest aspect ratio of the triangles of `dense`; degenerate
 /// triangles (zero area) are skipped, as the input's own can be.
@@ -244,4 +263,56 @@ fn shape(dense: &DenseMesh) -> (f64, f64) {
         max_aspect = max_aspect.max(longest / altitude * (3f64.sqrt() / 2.0));
     }
     (min_angle, max_aspect)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// The diagonal folded in parallel blocks is bit for bit the one-thread fold, on one thread
+    /// and on two, with a NaN, signed zeros and infinities among positions spread over several
+    /// blocks (the first position's own NaN included).
+    #[test]
+    fn diagonal_in_blocks_is_the_one_thread_fold() {
+        let serial = |mesh: &TriMesh| {
+            let first = mesh.positions[0];
+            let (lo, hi) = mesh
+                .positions
+                .iter()
+                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+            (hi - lo).length()
+        };
+        let n = 3 * DIAGONAL_BLOCK + 17;
+        let spread = |i: usize| ((i * 7919) % 10007) as f64 * 1e-3 - 5.0;
+        let mut cases: Vec<Vec<DVec3>> = Vec::new();
+        let plain: Vec<DVec3> = (0..n)
+            .map(|i| DVec3::new(spread(i), spread(i + 1), spread(i + 2)))
+            .collect();
+        cases.push(plain.clone());
+        let mut odd = plain.clone();
+        odd[0] = DVec3::new(f64::NAN, 0.0, -0.0);
+        odd[DIAGONAL_BLOCK + 3] = DVec3::new(-0.0, f64::NAN, 0.0);
+        odd[2 * DIAGONAL_BLOCK] = DVec3::new(0.0, -0.0, f64::INFINITY);
+        cases.push(odd);
+        let zeros: Vec<DVec3> = (0..n)
+            .map(|i| DVec3::splat(if i % 3 == 0 { -0.0 } else { 0.0 }))
+            .collect();
+        cases.push(zeros);
+        for positions in cases {
+            let mesh = TriMesh {
+                positions,
+                ..TriMesh::default()
+            };
+            let want = serial(&mesh);
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let got = pool.install(|| diagonal(&mesh));
+                assert_eq!(got.to_bits(), want.to_bits(), "{threads} threads");
+            }
+        }
+    }
 }
