@@ -54,6 +54,7 @@
 mod adaptive;
 mod blocks;
 mod chord;
+mod coarsen;
 mod counts;
 mod emit;
 mod estimate;
