@@ -85,8 +85,7 @@ pub(crate) fn coarsen(
             busy[t] = true;
             steps.push(Step::Inner(t as u32));
         }
-        for e in 0..counts.edges.len() {
-            let c = counts.edges[e];
+        for (e, (&c, failed)) in counts.edges.iter().zip(&failed_edge).enumerate() {
             if c < 2 {
                 continue;
             }
@@ -100,7 +99,7 @@ pub(crate) fn coarsen(
                 continue;
             }
             let sum: u64 = uses.iter().map(|u| version[u.tri().0 as usize]).sum();
-            if failed_edge[e] == Some(sum) {
+            if *failed == Some(sum) {
                 continue;
             }
             for u in uses {
