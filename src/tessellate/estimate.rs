@@ -294,8 +294,25 @@ fn row(points: &[SurfacePoint], level: u32, j: u32) -> &[SurfacePoint] {
 /// are `1/9`, `1/9`, `1/36`, each at most the centroid's `1/9`). It is at most
 /// `WEIGHT_GAIN · max |Q|` and tighter where the three differ, so fewer points whose error
 /// cannot change a maximum have [`worst_abs`] computed.
+///
+/// Where the three are finite (the sum of their absolute values is) the maxima are taken by
+/// comparison ([`larger`]), which gives `f64::max`'s values for numbers that are not NaN
+/// (absolute values have no signed zeros to tell apart) without its NaN handling (on the 10k
+/// icosphere at the error level 16 reaches, the predicted errors 705M → 604M instructions);
+/// [`bound_any`] otherwise, the same formula with `f64::max`.
 #[inline]
 fn bound(q: [f64; 3]) -> f64 {
+    let [a, b, c] = q.map(f64::abs);
+    let sum = a + b + c;
+    if sum.is_finite() {
+        BOUND_SLACK * larger(0.125 * larger(larger(a, b), c), sum * (1.0 / 18.0))
+    } else {
+        bound_any(q)
+    }
+}
+
+/// [`bound`] for any `q`, through `f64::max` (a NaN term is skipped as the maximum skips it).
+fn bound_any(q: [f64; 3]) -> f64 {
     let [a, b, c] = q.map(f64::abs);
     BOUND_SLACK * (0.125 * a.max(b).max(c)).max((a + b + c) * (1.0 / 18.0))
 }
@@ -767,6 +784,22 @@ mod tests {
         ] {
             let (a, b) = (worst_abs(q), worst_abs_any(q));
             assert!(a.to_bits() == b.to_bits(), "{q:?}: {a} against {b}");
+        }
+    }
+
+    /// The bound by comparisons is the formula through `f64::max`, bit for bit, finite or
+    /// not: the filter passes the same samples.
+    #[test]
+    fn the_bound_is_its_formula_bit_for_bit() {
+        let odd = [
+            [f64::INFINITY, 1.0, 0.0],
+            [f64::NAN, 1.0, 2.0],
+            [1.0, f64::NEG_INFINITY, f64::NAN],
+            [f64::MAX, f64::MAX, 1.0],
+            [-0.0, 0.0, -0.0],
+        ];
+        for q in sample_qs().into_iter().chain(odd) {
+            assert_eq!(bound(q).to_bits(), bound_any(q).to_bits(), "{q:?}");
         }
     }
 
