@@ -31,7 +31,10 @@
 //! Normals: exact, by forward differentiation of the patch formula ([`dual`]), including the
 //! directional derivatives inside its correction term (a dual of a dual). Central differences
 //! ([`NormalMethod::FiniteDifference`]) agree to 1.7e-7° but cost more, so analytic is the
-//! default.
+//! default. Where a smooth edge has split normals, the side each normal is turned to follows
+//! the mean end normals its edge surface is built from, blended with the weights of the
+//! auxiliary curves in Eq. 4 ([`EdgeNormals`]), so that both triangles pick the same side along
+//! the edge.
 //!
 //! Speed: Eq. 11 is linear in the 30 control points of the three constituents, with
 //! coefficients that depend only on the domain point, λ and the reading of Definition 2
@@ -62,6 +65,7 @@ use super::hybrid::{EdgeNets, PaperReading};
 use super::lattice_cache::{Entry, LatticeCache};
 use super::pn::{compose, Net, IJK};
 use super::scheme::creases::{own_nets, smooth_edges, Corners};
+use super::scheme::side::{self, EdgeNormals, NetNormals};
 use super::scheme::{SchemeParams, Warning};
 use super::{blend, lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
@@ -103,6 +107,8 @@ pub struct CoonsSurface {
     lambda: Vec<[f64; 3]>,
     smooth: Vec<bool>,
     warnings: Vec<Warning>,
+    /// The end normals of smooth edges with split normals, for the side of the normals.
+    sides: EdgeNormals,
     /// Whether another triangle has the same `λ`, so that lattice weights are worth keeping.
     shared_lambda: Vec<bool>,
     normals: NormalMethod,
@@ -184,6 +190,7 @@ impl CoonsSurface {
             .iter()
             .map(|l| uses[&l.map(f64::to_bits)] > 1)
             .collect();
+        let sides = EdgeNormals::new(&corners, topo, &smooth);
         CoonsSurface {
             corners,
             perm,
@@ -191,6 +198,7 @@ impl CoonsSurface {
             lambda,
             smooth,
             warnings,
+            sides,
             shared_lambda,
             normals: NormalMethod::default(),
             definition: Definition2::Corrected,
@@ -269,8 +277,8 @@ impl CoonsSurface {
         tri: usize,
         level: u32,
         pattern: &[LatticePoint],
-        i: u32,
-        j: u32,
+        nets: Option<&NetNormals>,
+        (i, j): (u32, u32),
     ) -> SurfacePoint {
         let perm = self.perm[tri];
         let e = [level - i - j, i, j];
@@ -279,13 +287,20 @@ impl CoonsSurface {
         for c in 0..3 {
             l[perm[c]] = p.x[c];
         }
-        self.analytic(tri, l, &p.weights)
+        self.analytic(tri, l, &p.weights, nets)
     }
 
     /// The surface point of triangle `tri` at input barycentrics `l` with the weights of its
-    /// canonical barycentrics: the one analytic path of both `evaluate` and the lattice.
+    /// canonical barycentrics: the one analytic path of both `evaluate` and the lattice. `nets`
+    /// is the triangle's `self.sides.of(tri)`, looked up once per triangle by the lattices.
     #[inline]
-    fn analytic(&self, tri: usize, l: [f64; 3], w: &Weights) -> SurfacePoint {
+    fn analytic(
+        &self,
+        tri: usize,
+        l: [f64; 3],
+        w: &Weights,
+        nets: Option<&NetNormals>,
+    ) -> SurfacePoint {
         let corners = &self.corners[tri];
         if let Some(p) = corners.at_corner(l) {
             return p;
@@ -297,9 +312,21 @@ impl CoonsSurface {
         let dv = s[0][1] * d0 + s[1][1] * d1;
         SurfacePoint {
             position,
-            normal: corners.orient(l, du, dv),
+            normal: side::orient(corners, nets, l, du, dv, curve_shares),
         }
     }
+}
+
+/// The weights of the three auxiliary curves in seed 002 Eq. 4, `u_j² u_k² / Σ` for the curve
+/// of edge `u_i = 0` with `Σ = v²w² + u²w² + u²v²`: how the patch follows each edge's
+/// constituent, exactly 1 on its edge and exactly 0 on the other two (the products that vanish
+/// there are exact zeros). Symmetric in the corners, so input and canonical order agree. Not
+/// finite at a corner.
+fn curve_shares(l: [f64; 3]) -> [f64; 3] {
+    let [a, b, c] = l.map(|x| x * x);
+    let s = [b * c, a * c, a * b];
+    let sum = s[0] + s[1] + s[2];
+    s.map(|x| x / sum)
 }
 
 /// The corners of a triangle sorted by position (lexicographic, total order): the Coons patch
@@ -372,7 +399,7 @@ impl Surface for CoonsSurface {
             NormalMethod::Analytic => {
                 let x = self.perm[tri].map(|c| l[c]);
                 let w = Weights::at(self.lambda[tri], x, self.definition);
-                self.analytic(tri, l, &w)
+                self.analytic(tri, l, &w, self.sides.of(tri))
             }
             NormalMethod::FiniteDifference => {
                 // The patch varies on the scale of the distance to the nearest corner.
@@ -383,7 +410,7 @@ impl Surface for CoonsSurface {
                 let dv = (at(0.0, e) - at(0.0, -e)) / (2.0 * e);
                 SurfacePoint {
                     position: self.position(tri, l),
-                    normal: corners.orient(l, du, dv),
+                    normal: side::orient(corners, self.sides.of(tri), l, du, dv, curve_shares),
                 }
             }
         }
@@ -392,10 +419,11 @@ impl Surface for CoonsSurface {
     fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
         out.reserve(lattice_len(level));
         let pattern = self.pattern(tri, level);
+        let nets = self.sides.of(tri);
         for j in 0..=level {
             for i in 0..=level - j {
                 out.push(match &pattern {
-                    Some(p) => self.lattice_point(tri, level, p, i, j),
+                    Some(p) => self.lattice_point(tri, level, p, nets, (i, j)),
                     None => self.evaluate(tri, lattice_bary(level, i, j)),
                 });
             }
@@ -410,8 +438,9 @@ impl Surface for CoonsSurface {
         out: &mut Vec<SurfacePoint>,
     ) {
         let pattern = self.pattern(tri, level);
+        let nets = self.sides.of(tri);
         out.extend(points.iter().map(|&(i, j)| match &pattern {
-            Some(p) => self.lattice_point(tri, level, p, i, j),
+            Some(p) => self.lattice_point(tri, level, p, nets, (i, j)),
             None => self.evaluate(tri, lattice_bary(level, i, j)),
         }));
     }

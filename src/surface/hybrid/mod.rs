@@ -21,7 +21,9 @@
 //! the edge's net is the triangle's own PN net with the crease curve both sides share
 //! ([`own_nets`]). The boundary curve is then the same cubic as in the PN and G²
 //! schemes, each side keeps its own tangent planes, and the join is G0. For split normals on a
-//! smooth edge both sides use the mean of their end normals for that edge.
+//! smooth edge both sides use the mean of their end normals for that edge, and the side each
+//! normal is turned to follows those means blended with Nielson's weights of Eq. 1
+//! ([`EdgeNormals`]), so that both triangles pick the same side along the edge.
 //!
 //! Speed: the patch is linear in the nets with coefficients that depend on the domain point only
 //! (Bernstein values, Eq. 2's `h_ij` and Eq. 1's Nielson weights, and their derivatives), so a
@@ -45,6 +47,7 @@ use rayon::prelude::*;
 use super::lattice_cache::{Entry, LatticeCache};
 use super::pn::{Net, B111, NEAR};
 use super::scheme::creases::{edge_end_normal, own_nets, smooth_edges, Corners};
+use super::scheme::side::{self, EdgeNormals, NetNormals};
 use super::scheme::Warning;
 use super::{lattice_bary, lattice_index, lattice_len, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
@@ -261,6 +264,8 @@ pub struct HybridSurface {
     smooth: Vec<bool>,
     /// Fallbacks taken while building.
     warnings: Vec<Warning>,
+    /// The end normals of smooth edges with split normals, for the side of the normals.
+    sides: EdgeNormals,
     /// Per triangle, the control points its [`Weights`] combine ([`patch::gather`]). The three
     /// edge nets they are gathered from are not kept (720 bytes a triangle, read by nothing
     /// after this).
@@ -308,10 +313,12 @@ impl HybridSurface {
             warnings,
         } = EdgeNets::new(mesh, topo, h_per_edge, reading);
         let terms = nets.par_iter().map(|n| patch::gather(n, blend)).collect();
+        let sides = EdgeNormals::new(&corners, topo, &smooth);
         HybridSurface {
             corners,
             smooth,
             warnings,
+            sides,
             terms,
             patterns: LatticeCache::new(Self::MAX_PATTERNS),
         }
@@ -345,9 +352,16 @@ impl HybridSurface {
     }
 
     /// The surface point of triangle `tri` at barycentrics `l` with weights `w` computed there:
-    /// the one path of both [`Surface::evaluate`] and the lattice.
+    /// the one path of both [`Surface::evaluate`] and the lattice. `nets` is the triangle's
+    /// `self.sides.of(tri)`, looked up once per triangle by the lattices.
     #[inline]
-    fn combine(&self, tri: usize, l: [f64; 3], w: &Weights) -> SurfacePoint {
+    fn combine(
+        &self,
+        tri: usize,
+        l: [f64; 3],
+        w: &Weights,
+        nets: Option<&NetNormals>,
+    ) -> SurfacePoint {
         let corners = &self.corners[tri];
         if let Some(p) = corners.at_corner(l) {
             return p;
@@ -355,7 +369,7 @@ impl HybridSurface {
         let [position, du, dv] = patch::combine(w, &self.terms[tri]);
         SurfacePoint {
             position,
-            normal: corners.orient(l, du, dv),
+            normal: side::orient(corners, nets, l, du, dv, patch::net_shares),
         }
     }
 }
@@ -365,16 +379,19 @@ impl Surface for HybridSurface {
         if let Some(p) = self.corners[tri].at_corner(bary) {
             return p;
         }
-        self.combine(tri, bary, &patch::weights(bary))
+        self.combine(tri, bary, &patch::weights(bary), self.sides.of(tri))
     }
 
     fn evaluate_lattice(&self, tri: usize, level: u32, out: &mut Vec<SurfacePoint>) {
         match self.pattern(level) {
-            Some(pattern) => out.extend(
-                pattern
-                    .iter()
-                    .map(|p| self.combine(tri, p.bary, &p.weights)),
-            ),
+            Some(pattern) => {
+                let nets = self.sides.of(tri);
+                out.extend(
+                    pattern
+                        .iter()
+                        .map(|p| self.combine(tri, p.bary, &p.weights, nets)),
+                )
+            }
             None => {
                 out.reserve(lattice_len(level));
                 for j in 0..=level {
@@ -394,10 +411,13 @@ impl Surface for HybridSurface {
         out: &mut Vec<SurfacePoint>,
     ) {
         match self.pattern(level) {
-            Some(pattern) => out.extend(points.iter().map(|&(i, j)| {
-                let p = &pattern[lattice_index(level, i, j)];
-                self.combine(tri, p.bary, &p.weights)
-            })),
+            Some(pattern) => {
+                let nets = self.sides.of(tri);
+                out.extend(points.iter().map(|&(i, j)| {
+                    let p = &pattern[lattice_index(level, i, j)];
+                    self.combine(tri, p.bary, &p.weights, nets)
+                }))
+            }
             None => out.extend(
                 points
                     .iter()

@@ -165,6 +165,15 @@ fn edge_weight(l: [f64; 3], i: usize, j: usize) -> (f64, [f64; 3]) {
     (p / den, g)
 }
 
+/// Nielson's weights of seed 001 Eq. 1 alone, `a_i = u_j u_k / (u_i u_j + u_i u_k + u_j u_k)`:
+/// net i's share of the interior point, exactly 1 on its edge `u_i = 0` and exactly 0 on the
+/// other two edges (the products that vanish there are exact zeros). Not finite at a corner.
+pub fn net_shares(l: [f64; 3]) -> [f64; 3] {
+    let [u0, u1, u2] = l;
+    let s = u0 * u1 + u0 * u2 + u1 * u2;
+    [u1 * u2 / s, u0 * u2 / s, u0 * u1 / s]
+}
+
 /// Nielson's weights of seed 001 Eq. 1 with their gradients; 0/0 only at the corners, where
 /// `b111`'s Bernstein factor vanishes (equal weights there).
 fn nielson(l: [f64; 3]) -> ([f64; 3], [[f64; 3]; 3]) {

@@ -44,20 +44,30 @@ impl Corners {
     }
 
     /// The unit normal of tangents `du × dv`, on the side of the interpolated input normals;
-    /// the interpolated normal itself where the tangents are parallel to rounding.
+    /// the interpolated normal itself where the tangents are parallel to rounding. (Triangles
+    /// of a smooth edge with split normals choose by the normals their edge nets share
+    /// instead: [`EdgeNormals`](super::side::EdgeNormals).)
     pub fn orient(&self, l: [f64; 3], du: DVec3, dv: DVec3) -> DVec3 {
         let interpolated = l[0] * self.normal[0] + l[1] * self.normal[1] + l[2] * self.normal[2];
+        Self::orient_to(interpolated, self.normal[0], du, dv)
+    }
+
+    /// The unit normal of tangents `du × dv`, on the side of `reference`; `reference` itself
+    /// (normalized, else `fallback`) where the tangents are parallel to rounding
+    /// (`|du × dv| ≤ 1e-14·|du|·|dv|`, a degenerate triangle).
+    #[inline]
+    pub fn orient_to(reference: DVec3, fallback: DVec3, du: DVec3, dv: DVec3) -> DVec3 {
         let n = du.cross(dv);
         let len2 = n.length_squared();
         if len2 > 1e-28 * du.length_squared() * dv.length_squared() && len2.is_finite() {
             let n = n / len2.sqrt();
-            if n.dot(interpolated) < 0.0 {
+            if n.dot(reference) < 0.0 {
                 -n
             } else {
                 n
             }
         } else {
-            interpolated.normalize_or(self.normal[0])
+            reference.normalize_or(fallback)
         }
     }
 }

@@ -15,9 +15,11 @@
 //!
 //! In every scheme the boundary curve of an edge is computed once for both sides, so the surface
 //! is watertight at any h; at a crease each side stays tangent to its own input normals
-//! ([`creases`]).
+//! ([`creases`]). Where a smooth edge of the hybrid or Coons scheme has split normals, both
+//! sides turn their normals to the side of the end normals they share ([`side`]).
 
 pub mod creases;
+pub mod side;
 
 use std::fmt;
 use std::str::FromStr;
