@@ -183,17 +183,16 @@ fn nielson(l: [f64; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
         return ([1.0 / 3.0; 3], [[0.0; 3]; 3]);
     }
     let gs = [u1 + u2, u0 + u2, u0 + u1];
-    let mut a = [0.0; 3];
+    let a = net_shares(l);
     let mut g = [[0.0; 3]; 3];
-    for i in 0..3 {
+    for (i, gi) in g.iter_mut().enumerate() {
         let (j, k) = ((i + 1) % 3, (i + 2) % 3);
         let n = l[j] * l[k];
-        a[i] = n / s;
         let mut gn = [0.0; 3];
         gn[j] = l[k];
         gn[k] = l[j];
         for c in 0..3 {
-            g[i][c] = (gn[c] * s - n * gs[c]) / (s * s);
+            gi[c] = (gn[c] * s - n * gs[c]) / (s * s);
         }
     }
     (a, g)
