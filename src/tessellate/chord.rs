@@ -223,6 +223,75 @@ pub(crate) fn measured_error(
     error
 }
 
+/// The chord error and the smallest angle in space (radians) of each of `candidates`,
+/// triangles of `pattern`'s points that need not be among its own (`fill.rs` chooses among
+/// them), measured as [`measured_error`] measures the pattern's: the vertices evaluated as it
+/// evaluates them and rounded to `f32`, seven samples each, all evaluated in one call.
+pub(crate) fn candidate_errors(
+    surface: &dyn Surface,
+    tri: usize,
+    pattern: &Pattern,
+    candidates: &[[u32; 3]],
+    samples: &mut Samples,
+) -> Vec<(f64, f64)> {
+    samples.points.clear();
+    surface.evaluate_points(
+        tri,
+        &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        &mut samples.points,
+    );
+    for k in 0..3 {
+        let n = pattern.key.edges[k];
+        if n > 1 {
+            surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut samples.points);
+        }
+    }
+    if pattern.key.inner >= 3 {
+        surface.evaluate_lattice_part(
+            tri,
+            pattern.key.inner,
+            LatticePart::Interior,
+            &mut samples.points,
+        );
+    }
+    debug_assert_eq!(samples.points.len(), pattern.lattice.len());
+    let vertices: Vec<DVec3> = samples.points.iter().map(|p| written(p.position)).collect();
+    samples.barys.clear();
+    for t in candidates {
+        let bary = t.map(|p| pattern.bary(p));
+        samples.barys.extend(WEIGHTS.iter().map(|w| {
+            let mut domain = [0.0; 3];
+            for (c, b) in bary.iter().enumerate() {
+                for (d, x) in domain.iter_mut().zip(b) {
+                    *d += w[c] * x;
+                }
+            }
+            domain
+        }));
+    }
+    samples.points.clear();
+    surface.evaluate_points(tri, &samples.barys, &mut samples.points);
+    candidates
+        .iter()
+        .zip(samples.points.chunks_exact(WEIGHTS.len()))
+        .map(|(t, on_surface)| {
+            let flat = t.map(|p| vertices[p as usize]);
+            (sampled_error(flat, on_surface), angle_in_space(flat))
+        })
+        .collect()
+}
+
+/// The smallest angle of the triangle with corners `p`, in radians (0 if degenerate).
+fn angle_in_space(p: [DVec3; 3]) -> f64 {
+    (0..3)
+        .map(|c| {
+            let u = p[(c + 1) % 3] - p[c];
+            let v = p[(c + 2) % 3] - p[c];
+            u.cross(v).length().atan2(u.dot(v))
+        })
+        .fold(f64::MAX, f64::min)
+}
+
 /// The output triangles of a pattern at its source triangle's corners (those with a corner
 /// among their vertices) and the domain points [`corner_error`] evaluates for them: the same
 /// for every source triangle with that pattern, so found once per pattern instead of once per
@@ -381,7 +450,7 @@ mod tests {
     fn the_corner_error_is_that_of_the_corner_triangles_measured_one_by_one() {
         let keys = [([20, 20, 20], 20), ([17, 16, 20], 18), ([13, 9, 18], 14)];
         for (edges, inner) in keys {
-            let pattern = Pattern::new(PatternKey { edges, inner });
+            let pattern = Pattern::new(PatternKey::new(edges, inner));
             let at_corner = |t: usize| pattern.triangles[t].iter().any(|&p| p < 3);
             let vertices: Vec<DVec3> = (0..pattern.lattice.len() as u32)
                 .map(|p| written(Field.evaluate(0, pattern.bary(p)).position))

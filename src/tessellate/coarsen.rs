@@ -11,8 +11,11 @@
 //! `MEASURED_UP_TO` of `counts.rs`) take part, before and after the step, so the check that
 //! keeps a step is the one the raise ends with on those patterns: the chord error along the
 //! normal at seven points of every output triangle, on the vertices rounded to `f32` as written
-//! (`chord.rs`). Steps keep both balance rules (an edge at least half the inner level of each
-//! triangle beside it, an inner level at least [`inner_floor`] of its finest edge).
+//! (`chord.rs`). A triangle a step leaves without interior points whose default fill fails is
+//! given, if there is one, a fill of its edge samples that passes (`fill.rs`), and the step
+//! kept with it; its fill goes back with its counts when the step fails. Steps keep both
+//! balance rules (an edge at least half the inner level of each triangle beside it, an inner
+//! level at least [`inner_floor`] of its finest edge).
 //!
 //! Steps are tried in rounds. A round takes steps whose triangles are disjoint (a step is an
 //! edge, touching the triangles beside it, or one triangle's inner level), chosen in a fixed
@@ -26,6 +29,7 @@ use rayon::prelude::*;
 
 use super::chord::{measured_error, Samples};
 use super::counts::{inner_floor, SegmentCounts};
+use super::fill::fill_within;
 use super::transition::{Pattern, PatternKey};
 use crate::surface::Surface;
 use crate::topology::{EdgeId, Topology};
@@ -129,6 +133,12 @@ pub(crate) fn coarsen(
         let mut checked: Vec<usize> = steps.iter().flat_map(|&s| touched(s)).collect();
         checked.sort_unstable();
         checked.dedup();
+        // A triangle whose counts change starts from the default fill; its fill before is
+        // restored if the step fails.
+        let fills_before: Vec<u16> = checked
+            .iter()
+            .map(|&t| std::mem::take(&mut counts.fill[t]))
+            .collect();
         let mut fresh: Vec<PatternKey> = checked
             .iter()
             .map(|&t| counts.key(topo, t))
@@ -138,21 +148,37 @@ pub(crate) fn coarsen(
         fresh.dedup();
         let patterns: Vec<Pattern> = fresh.par_iter().map(|&k| Pattern::new(k)).collect();
         built.extend(fresh.into_iter().zip(patterns));
-        let passes: Vec<bool> = checked
+        // Per checked triangle, whether it passes and with which fill (0 unless the default
+        // fill fails and one chosen by measured error passes).
+        let passes: Vec<Option<u16>> = checked
             .par_iter()
             .map_init(Samples::default, |samples, &t| {
-                let pattern = &built[&counts.key(topo, t)];
-                measured_error(surface, t, pattern, samples).within(tolerance)
+                let key = counts.key(topo, t);
+                if measured_error(surface, t, &built[&key], samples).within(tolerance) {
+                    return Some(0);
+                }
+                if key.inner >= 3 {
+                    return None;
+                }
+                let fill = fill_within(surface, t, key, tolerance, samples)?;
+                let filled = Pattern::new(PatternKey { fill, ..key });
+                measured_error(surface, t, &filled, samples)
+                    .within(tolerance)
+                    .then_some(fill)
             })
             .collect();
         let passes_at = |t: usize| passes[checked.binary_search(&t).expect("checked")];
         for &step in &steps {
             let on = touched(step);
-            if on.iter().all(|&t| passes_at(t)) {
+            if on.iter().all(|&t| passes_at(t).is_some()) {
                 for &t in &on {
                     version[t] += 1;
+                    counts.fill[t] = passes_at(t).expect("passes");
                 }
                 continue;
+            }
+            for &t in &on {
+                counts.fill[t] = fills_before[checked.binary_search(&t).expect("checked")];
             }
             let sum: u64 = on.iter().map(|&t| version[t]).sum();
             match step {

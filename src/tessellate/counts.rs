@@ -112,6 +112,10 @@ pub struct SegmentCounts {
     pub edges: Vec<u32>,
     /// Inner lattice level of each source triangle.
     pub inner: Vec<u32>,
+    /// How each source triangle without interior fills the polygon of its edge samples: 0,
+    /// by ears of largest minimum angle in the domain, but where the lowering of counts
+    /// (`coarsen.rs`) chose a triangulation by measured chord error (`fill.rs`).
+    pub fill: Vec<u16>,
 }
 
 impl ChordErrors {
@@ -217,6 +221,7 @@ impl ChordErrors {
                 .iter()
                 .map(|&c| initial_inner(need(c)))
                 .collect(),
+            fill: vec![0; self.triangles.len()],
         };
         counts.balance(topo);
         counts
@@ -434,7 +439,7 @@ impl ChordErrors {
 /// A pattern key as one nonzero number (every count is between 1 and 255).
 fn pack(key: PatternKey) -> u64 {
     let [a, b, c] = key.edges.map(u64::from);
-    a | b << 16 | c << 32 | u64::from(key.inner) << 48
+    a | b << 8 | c << 16 | u64::from(key.inner) << 24 | u64::from(key.fill) << 32
 }
 
 /// The smallest inner level a triangle whose finest edge has `max_edge` segments may have:
@@ -498,6 +503,7 @@ impl SegmentCounts {
         SegmentCounts {
             edges: vec![level; topo.edge_count()],
             inner: vec![level; topo.tri_edges.len()],
+            fill: vec![0; topo.tri_edges.len()],
         }
     }
 
@@ -507,6 +513,7 @@ impl SegmentCounts {
         PatternKey {
             edges: topo.tri_edges[tri].map(|e| self.edges[e.0 as usize]),
             inner: self.inner[tri],
+            fill: self.fill[tri],
         }
     }
 

@@ -620,7 +620,7 @@ mod tests {
             ([6, 6, 6], 6),
             ([9, 8, 5], 9),
         ]
-        .map(|(edges, inner)| PatternKey { edges, inner })
+        .map(|(edges, inner)| PatternKey::new(edges, inner))
         .to_vec()
     }
 

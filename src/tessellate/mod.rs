@@ -58,6 +58,7 @@ mod coarsen;
 mod counts;
 mod emit;
 mod estimate;
+mod fill;
 mod held;
 mod lattice_edges;
 mod layout;

@@ -17,7 +17,8 @@
 //! triangles whichever is larger, so [`PatternKey::triangle_count`] holds), around one inner
 //! point at `M = 3`; at `M ≤ 2` there is no interior and the polygon of the edge samples is cut
 //! by ears of largest minimum angle, which on a triangle curved along two edges and flat along
-//! the third gives triangles running along the flat direction.
+//! the third gives triangles running along the flat direction, or, where the key's `fill` names
+//! one, by a triangulation chosen per source triangle by measured chord error (`fill.rs`).
 //!
 //! Points are numbered per pattern: the three corners, then the samples of edge 0, 1 and 2
 //! (`counts[k] − 1` each, step `m` walked from corner `k + 1`), then the level-`M` interior in
@@ -41,9 +42,24 @@ pub(crate) struct PatternKey {
     /// keeps it at least two thirds of the largest edge count and every edge at least half of
     /// it, where the patterns' triangles are well shaped (see the tests).
     pub inner: u32,
+    /// How a pattern without interior (`inner ≤ 2`) fills the polygon of its edge samples: 0,
+    /// by ears of largest minimum angle in the domain; `f ≥ 1`, by triangulation `f − 1` of
+    /// that polygon in the order of [`triangulation`], chosen per source triangle by measured
+    /// chord error (`fill.rs`). Always 0 with an inner lattice.
+    pub fill: u16,
 }
 
 impl PatternKey {
+    /// The key of `edges` around `inner` with the default fill.
+    #[cfg(test)]
+    pub fn new(edges: [u32; 3], inner: u32) -> PatternKey {
+        PatternKey {
+            edges,
+            inner,
+            fill: 0,
+        }
+    }
+
     /// Number of triangles of the pattern, without building it: `Σe + M(M − 3)` with an inner
     /// lattice (`M ≥ 3`; `M²` when all counts equal `M`), else the `Σe − 2` triangles of a
     /// polygon with `Σe` vertices.
@@ -81,7 +97,9 @@ impl Pattern {
     /// # Panics
     /// If a count is 0 or above 255.
     pub fn new(key: PatternKey) -> Pattern {
-        let PatternKey { edges, inner: m } = key;
+        let PatternKey {
+            edges, inner: m, ..
+        } = key;
         assert!(
             edges.iter().chain([&m]).all(|&c| (1..=255).contains(&c)),
             "counts {key:?}"
@@ -110,7 +128,7 @@ impl Pattern {
             interior_by_rank: Vec::new(),
             triangles: Vec::new(),
         };
-        if edges == [m; 3] {
+        if edges == [m; 3] && key.fill == 0 {
             pattern.triangles = uniform_triangles(&pattern, m);
         } else {
             pattern.triangles = stitched_triangles(&pattern);
@@ -133,6 +151,11 @@ impl Pattern {
     pub fn bary(&self, p: u32) -> [f64; 3] {
         let [n, i, j] = self.lattice[p as usize].map(f64::from);
         [(n - i - j) / n, i / n, j / n]
+    }
+
+    /// Position of point `p` in the equilateral reference triangle, where angles are judged.
+    pub fn domain(&self, p: u32) -> [f64; 2] {
+        domain(self.bary(p))
     }
 
     /// The source triangle's edges output triangle `t` touches (bit `k` for edge `k`; a corner
@@ -196,6 +219,11 @@ fn uniform_triangles(pattern: &Pattern, m: u32) -> Vec<[u32; 3]> {
     plan.triangles.iter().map(|t| t.map(point)).collect()
 }
 
+/// The worst minimum angle in the domain over the default patterns the balance allows,
+/// `atan(√3/5)` = 19.1° (see the tests), less a rounding allowance: the floor a fill chosen by
+/// measured error (`fill.rs`) keeps.
+pub(crate) const ANGLE_FLOOR: f64 = 0.333_473_172_251_832_1 - 1e-9;
+
 /// Position of barycentrics `b` in the equilateral reference triangle of side 1, where angles
 /// are judged.
 fn domain(b: [f64; 3]) -> [f64; 2] {
@@ -226,7 +254,11 @@ fn inside(p: [f64; 2], a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> bool {
 
 /// Ears, stitched ring and inner lattice (see the module docs).
 fn stitched_triangles(pattern: &Pattern) -> Vec<[u32; 3]> {
-    let PatternKey { edges, inner: m } = pattern.key;
+    let PatternKey {
+        edges,
+        inner: m,
+        fill,
+    } = pattern.key;
     let at = |p: u32| domain(pattern.bary(p));
     let mut triangles = Vec::with_capacity(pattern.key.triangle_count() as usize);
 
@@ -250,9 +282,24 @@ fn stitched_triangles(pattern: &Pattern) -> Vec<[u32; 3]> {
     }
 
     if m < 3 {
-        clip_ears(&mut outer, &at, &mut triangles);
+        if fill == 0 {
+            clip_ears(&mut outer, &at, &mut triangles);
+        } else {
+            let index = u32::from(fill - 1);
+            assert!(
+                index < triangulations(outer.len()),
+                "fill {fill} of a polygon of {} points",
+                outer.len()
+            );
+            triangles.extend(triangulation(outer.len(), index).map(|t| t.map(|v| outer[v])));
+        }
         return triangles;
     }
+    assert_eq!(
+        fill, 0,
+        "a fill needs a pattern without interior: {:?}",
+        pattern.key
+    );
 
     // The inner ring, counter-clockwise from the inner corner next to corner 0.
     let inner: Vec<u32> = if m == 3 {
@@ -351,6 +398,57 @@ fn clip_ears(polygon: &mut Vec<u32>, at: &dyn Fn(u32) -> [f64; 2], out: &mut Vec
     }
 }
 
+/// The points of the polygon a pattern without interior (`inner ≤ 2`) fills: its corners
+/// and edge samples counter-clockwise from corner 0 (edge 2, edge 0, edge 1), the order
+/// [`PatternKey::fill`] numbers its triangulations in.
+pub(crate) fn polygon(pattern: &Pattern) -> Vec<u32> {
+    assert!(pattern.key.inner < 3, "{:?} has an interior", pattern.key);
+    let mut outer = Vec::new();
+    for (c, k) in [(0usize, 2usize), (1, 0), (2, 1)] {
+        outer.push(c as u32);
+        outer.extend((1..pattern.key.edges[k]).map(|s| pattern.edge(k, s)));
+    }
+    outer
+}
+
+/// Number of triangulations of a convex polygon of `n` points: the Catalan number
+/// `C(n − 2)` (1 for a triangle, 429 for the 9 points of edges 3, 3, 3 around no interior).
+pub(crate) fn triangulations(n: usize) -> u32 {
+    // C(k + 1) = Σ C(i)·C(k − i).
+    let mut catalan = vec![1u32];
+    for k in 0..n.saturating_sub(2) {
+        catalan.push((0..=k).map(|i| catalan[i] * catalan[k - i]).sum());
+    }
+    catalan[n.saturating_sub(2)]
+}
+
+/// Triangulation `index` of the convex polygon of points `0..n`, counter-clockwise, as
+/// triangles of polygon positions: the triangle on the side `(0, n − 1)` has its apex at the
+/// first `k` whose block (the triangulations of `0..=k` times those of `k..n`) holds the
+/// index, the sub-polygons numbered the same way, the right one's index running fastest.
+/// `fill.rs` finds a triangulation and its index by the same recursion.
+pub(crate) fn triangulation(n: usize, index: u32) -> impl Iterator<Item = [usize; 3]> {
+    let mut out = Vec::with_capacity(n.saturating_sub(2));
+    let mut pending = vec![(0usize, n - 1, index)];
+    while let Some((lo, hi, mut index)) = pending.pop() {
+        if hi - lo < 2 {
+            continue;
+        }
+        for k in lo + 1..hi {
+            let right = triangulations(hi - k + 1);
+            let block = triangulations(k - lo + 1) * right;
+            if index < block {
+                out.push([lo, k, hi]);
+                pending.push((k, hi, index % right));
+                pending.push((lo, k, index / right));
+                break;
+            }
+            index -= block;
+        }
+    }
+    out.into_iter()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -407,10 +505,7 @@ mod tests {
     #[test]
     fn uniform_counts_give_the_uniform_lattice() {
         for m in 1..=12 {
-            let key = PatternKey {
-                edges: [m; 3],
-                inner: m,
-            };
+            let key = PatternKey::new([m; 3], m);
             let worst = check(key);
             assert!((worst - std::f64::consts::FRAC_PI_3).abs() < 1e-9, "{m}");
         }
@@ -425,10 +520,7 @@ mod tests {
             for a in low..=m {
                 for b in low..=m {
                     for c in low..=m {
-                        let angle = check(PatternKey {
-                            edges: [a, b, c],
-                            inner: m,
-                        });
+                        let angle = check(PatternKey::new([a, b, c], m));
                         worst = worst.min(angle);
                     }
                 }
@@ -453,10 +545,7 @@ mod tests {
             for a in low..=high {
                 for b in low..=high {
                     for c in low..=high {
-                        let key = PatternKey {
-                            edges: [a, b, c],
-                            inner: m,
-                        };
+                        let key = PatternKey::new([a, b, c], m);
                         if a.max(b).max(c) <= m
                             || crate::tessellate::counts::inner_floor(a.max(b).max(c)) > m
                         {
@@ -485,14 +574,63 @@ mod tests {
     }
 
     #[test]
+    fn every_fill_index_is_a_distinct_triangulation_of_the_polygon() {
+        // Catalan numbers C(n − 2), and each index decodes to n − 2 triangles of the polygon's
+        // points counter-clockwise, every inner diagonal shared by two of them, no two indices
+        // alike.
+        let counts: Vec<u32> = (3..=9).map(triangulations).collect();
+        assert_eq!(counts, [1, 2, 5, 14, 42, 132, 429]);
+        for n in 3..=9usize {
+            let mut seen = std::collections::HashSet::new();
+            for index in 0..triangulations(n) {
+                let mut t: Vec<[usize; 3]> = triangulation(n, index).collect();
+                assert_eq!(t.len(), n - 2, "{n} {index}");
+                let mut sides: HashMap<(usize, usize), u32> = HashMap::new();
+                for &[a, b, c] in &t {
+                    assert!(a < b && b < c && c < n, "{n} {index}: {t:?}");
+                    for side in [(a, b), (b, c), (a, c)] {
+                        *sides.entry(side).or_default() += 1;
+                    }
+                }
+                for (&(a, b), &uses) in &sides {
+                    let boundary = b == a + 1 || (a == 0 && b == n - 1);
+                    assert_eq!(uses, if boundary { 1 } else { 2 }, "{n} {index}: {t:?}");
+                }
+                t.sort_unstable();
+                assert!(seen.insert(t), "{n} {index} repeats a triangulation");
+            }
+        }
+    }
+
+    #[test]
+    fn a_fill_that_keeps_the_floor_tiles_the_triangle() {
+        // Every fill of edges 3, 3, 2 around no interior whose triangles keep the floor is a
+        // pattern like the default one: same points, same count, tiling the triangle.
+        let key = PatternKey::new([3, 3, 2], 2);
+        let base = Pattern::new(key);
+        let outer = polygon(&base);
+        let mut kept = 0;
+        for index in 0..triangulations(outer.len()) {
+            let keeps = triangulation(outer.len(), index).all(|t| {
+                let [a, b, c] = t.map(|v| base.domain(outer[v]));
+                min_angle(a, b, c) >= ANGLE_FLOOR
+            });
+            if keeps {
+                kept += 1;
+                let fill = u16::try_from(index + 1).unwrap();
+                let worst = check(PatternKey { fill, ..key });
+                assert!(worst >= ANGLE_FLOOR, "{index}");
+            }
+        }
+        assert!(kept > 1, "{kept}");
+    }
+
+    #[test]
     fn a_triangle_flat_along_one_edge_is_filled_from_its_edge_samples() {
         // Three segments on two edges, one on the third, no interior: five triangles, none
         // with a vertex inside, each joining the two fine edges or one of them to the coarse
         // one (the polygon of 3 + 3 + 1 boundary points, not the nine of level 3).
-        let key = PatternKey {
-            edges: [1, 3, 3],
-            inner: 2,
-        };
+        let key = PatternKey::new([1, 3, 3], 2);
         check(key);
         let pattern = Pattern::new(key);
         assert_eq!(pattern.triangles.len(), 5);
