@@ -350,7 +350,14 @@ impl ChordErrors {
                             }
                         }
                     }
-                    let error = model.error(curvature);
+                    // Stages 0 and 2 compare passing parts with the tolerance and use the
+                    // value of failing ones only; stage 1's bound of the finer check reads
+                    // every part's value.
+                    let error = if factor == 1 {
+                        model.error(curvature)
+                    } else {
+                        model.error_over(curvature, predicted)
+                    };
                     if factor == 1 {
                         // The spread is needed where this check passes, or may pass when
                         // restored with its inner level as it is (its inner lattice passes).

@@ -496,6 +496,16 @@ impl PatternModel {
     /// The predicted errors of this pattern over the surface whose second differences are
     /// `curvature` (the lattice the model was built for).
     pub fn error(&self, curvature: &mut Curvature) -> PatternError {
+        self.error_over(curvature, 0.0)
+    }
+
+    /// [`PatternModel::error`] where only the parts above `floor` need their value: each edge
+    /// part above `floor` is the same bits as [`PatternModel::error`]'s, one at or below it any
+    /// value at most its own (the inner part is always exact). A check that only compares
+    /// passing parts with `floor` and scales failing ones by their value decides the same with
+    /// either. A sample whose bound is at or below `floor` is not summed: it cannot raise a part
+    /// above `floor`, as one under the part's maximum so far cannot raise that maximum.
+    pub fn error_over(&self, curvature: &mut Curvature, floor: f64) -> PatternError {
         let mut out = PatternError {
             inner: curvature.inner_error(self.key.inner),
             edges: [0.0; 3],
@@ -517,7 +527,7 @@ impl PatternModel {
                 let k = mask.trailing_zeros() as usize;
                 let mut worst = out.edges[k];
                 for t in run {
-                    worst = larger(worst, curvature.sample_error(t, worst, l2));
+                    worst = larger(worst, curvature.sample_error(t, larger(worst, floor), l2));
                 }
                 out.edges[k] = worst;
                 continue;
@@ -531,8 +541,8 @@ impl PatternModel {
                         f64::INFINITY
                     }
                 };
-                let floor = touched(0).min(touched(1)).min(touched(2));
-                let e = curvature.sample_error(t, floor, l2);
+                let below = larger(touched(0).min(touched(1)).min(touched(2)), floor);
+                let e = curvature.sample_error(t, below, l2);
                 for (k, edge) in out.edges.iter_mut().enumerate() {
                     if mask & (1 << k) != 0 {
                         *edge = larger(*edge, e);
@@ -744,6 +754,48 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// [`PatternModel::error_over`] gives every part above its floor with the bits of
+    /// [`PatternModel::error`], and every part at or below it at most the floor, at floors
+    /// between, at and around the parts' values: a check comparing with the floor decides the
+    /// same, and scales a failing part by the same value.
+    #[test]
+    fn the_error_over_a_floor_is_exact_above_it() {
+        let (mut above, mut below) = (0, 0);
+        for f in smooth_fields() {
+            for key in keys() {
+                let pattern = Pattern::new(key);
+                for level in [6, key.inner, 2 * key.inner] {
+                    let model = PatternModel::new(&pattern, level);
+                    let points = height_lattice(level, 1.0, &f);
+                    let exact = model.error(&mut curvature(&points, level));
+                    let parts = exact.edges;
+                    let mut floors: Vec<f64> = parts.to_vec();
+                    for p in parts {
+                        floors.extend([0.5 * p, 0.99 * p, 1.01 * p, 2.0 * p]);
+                    }
+                    for floor in floors {
+                        let over = model.error_over(&mut curvature(&points, level), floor);
+                        assert_eq!(over.inner.to_bits(), exact.inner.to_bits());
+                        for k in 0..3 {
+                            if exact.edges[k] > floor {
+                                above += 1;
+                                assert_eq!(
+                                    over.edges[k].to_bits(),
+                                    exact.edges[k].to_bits(),
+                                    "{key:?} at {level}, floor {floor}"
+                                );
+                            } else {
+                                below += 1;
+                                assert!(over.edges[k] <= floor, "{key:?} at {level}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(above > 100 && below > 100, "{above} above, {below} below");
     }
 
     /// `q` spread over magnitudes and signs, from a fixed-seed generator, with the cases
