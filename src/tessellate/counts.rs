@@ -351,19 +351,22 @@ impl ChordErrors {
                         }
                     }
                     // Stages 0 and 2 compare passing parts with the tolerance and use the
-                    // value of failing ones only; stage 1's bound of the finer check reads
-                    // every part's value.
+                    // value of failing ones only; stage 1 also asks whether its bound of the
+                    // finer check passes, which parts under `skip_floors` do whatever their
+                    // value.
                     let error = if factor == 1 {
-                        model.error(curvature)
+                        let inner = curvature.inner_error(model.inner());
+                        // The spread is needed where this check passes, or may pass when
+                        // restored with its inner level as it is (its inner lattice passes).
+                        if read && inner <= predicted {
+                            curvature.measure_spread(points);
+                        }
+                        let floors = model.skip_floors(inner, predicted, curvature.spread());
+                        model.error_over_each(curvature, floors)
                     } else {
                         model.error_over(curvature, predicted)
                     };
                     if factor == 1 {
-                        // The spread is needed where this check passes, or may pass when
-                        // restored with its inner level as it is (its inner lattice passes).
-                        if read && error.inner <= predicted {
-                            curvature.measure_spread(points);
-                        }
                         let finer = model.bound(&error, curvature.spread());
                         let skip = if finer.within(predicted) { key } else { 0 };
                         resolved[tri].store(skip, Ordering::Relaxed);

@@ -493,8 +493,38 @@ impl PatternModel {
         }
     }
 
+    /// The floors per edge part ([`PatternModel::error_over_each`]) under which a part's value
+    /// decides nothing for a check against `tolerance` that also asks whether
+    /// [`PatternModel::bound`] with `spread` is within it, the inner part's error being
+    /// `inner`: the largest `f` with `f + gain · spread` at most `tolerance` in floating point
+    /// (addition rounds monotonically, so every value at or below `f` passes the bound as `f`
+    /// does, and passes the tolerance); the tolerance itself where the bound cannot pass
+    /// whatever the edges (its inner part over the tolerance, or the spread not finite).
+    pub fn skip_floors(&self, inner: f64, tolerance: f64, spread: f64) -> [f64; 3] {
+        let bound = self.bound(
+            &PatternError {
+                inner,
+                edges: [0.0; 3],
+            },
+            spread,
+        );
+        if !(spread.is_finite() && bound.inner <= tolerance) {
+            return [tolerance; 3];
+        }
+        [0, 1, 2].map(|k| {
+            let grown = self.edge_gains[k] * spread;
+            let mut f = tolerance - grown;
+            while f > 0.0 && f + grown > tolerance {
+                // The next float down (`f` is positive and finite here).
+                f = f64::from_bits(f.to_bits() - 1);
+            }
+            f.min(tolerance)
+        })
+    }
+
     /// The predicted errors of this pattern over the surface whose second differences are
     /// `curvature` (the lattice the model was built for).
+    #[cfg(test)]
     pub fn error(&self, curvature: &mut Curvature) -> PatternError {
         self.error_over(curvature, 0.0)
     }
@@ -506,6 +536,11 @@ impl PatternModel {
     /// either. A sample whose bound is at or below `floor` is not summed: it cannot raise a part
     /// above `floor`, as one under the part's maximum so far cannot raise that maximum.
     pub fn error_over(&self, curvature: &mut Curvature, floor: f64) -> PatternError {
+        self.error_over_each(curvature, [floor; 3])
+    }
+
+    /// [`PatternModel::error_over`] with a floor per edge part, `floors[k]` for edge `k`'s.
+    pub fn error_over_each(&self, curvature: &mut Curvature, floors: [f64; 3]) -> PatternError {
         let mut out = PatternError {
             inner: curvature.inner_error(self.key.inner),
             edges: [0.0; 3],
@@ -527,21 +562,25 @@ impl PatternModel {
                 let k = mask.trailing_zeros() as usize;
                 let mut worst = out.edges[k];
                 for t in run {
-                    worst = larger(worst, curvature.sample_error(t, larger(worst, floor), l2));
+                    worst = larger(
+                        worst,
+                        curvature.sample_error(t, larger(worst, floors[k]), l2),
+                    );
                 }
                 out.edges[k] = worst;
                 continue;
             }
             for t in run {
-                // The smallest maximum this sample could raise.
+                // The smallest maximum this sample could raise, or the floor of its part
+                // where that is above it.
                 let touched = |k: usize| {
                     if mask & (1 << k) != 0 {
-                        out.edges[k]
+                        larger(out.edges[k], floors[k])
                     } else {
                         f64::INFINITY
                     }
                 };
-                let below = larger(touched(0).min(touched(1)).min(touched(2)), floor);
+                let below = touched(0).min(touched(1)).min(touched(2));
                 let e = curvature.sample_error(t, below, l2);
                 for (k, edge) in out.edges.iter_mut().enumerate() {
                     if mask & (1 << k) != 0 {
@@ -796,6 +835,49 @@ mod tests {
             }
         }
         assert!(above > 100 && below > 100, "{above} above, {below} below");
+    }
+
+    /// Stage 1's check decides the same with [`PatternModel::skip_floors`] as with every part
+    /// exact: whether each part passes the tolerance, the value of each failing one, and
+    /// whether the bound of the finer check passes; at tolerances around the parts' values,
+    /// so that both outcomes of each question occur.
+    #[test]
+    fn the_skip_floors_decide_as_the_exact_parts() {
+        let (mut skipped, mut kept) = (0, 0);
+        for f in smooth_fields() {
+            for key in keys() {
+                let pattern = Pattern::new(key);
+                let level = key.inner.max(6);
+                let model = PatternModel::new(&pattern, level);
+                let points = height_lattice(level, 1.0, &f);
+                let mut c = curvature(&points, level);
+                let exact = model.error(&mut c);
+                let spread = c.spread();
+                let largest = exact.edges.iter().fold(exact.inner, |a, &b| a.max(b));
+                for scale in [0.5, 0.9, 1.0, 1.1, 1.5, 2.0, 4.0, 16.0] {
+                    let tolerance = scale * largest;
+                    let floors = model.skip_floors(exact.inner, tolerance, spread);
+                    let over = model.error_over_each(&mut c, floors);
+                    assert_eq!(over.within(tolerance), exact.within(tolerance));
+                    for k in 0..3 {
+                        if exact.edges[k] > tolerance {
+                            assert_eq!(over.edges[k].to_bits(), exact.edges[k].to_bits());
+                        }
+                    }
+                    let finer = |e: &PatternError| model.bound(e, spread).within(tolerance);
+                    assert_eq!(finer(&over), finer(&exact), "{key:?} at {tolerance}");
+                    if finer(&exact) {
+                        skipped += 1;
+                    } else {
+                        kept += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            skipped > 10 && kept > 10,
+            "{skipped} pass the bound, {kept} do not"
+        );
     }
 
     /// `q` spread over magnitudes and signs, from a fixed-seed generator, with the cases
