@@ -160,7 +160,8 @@ impl ChordErrors {
                         debug_assert_eq!(kept.len(), PROBE_STRIDE);
                     }
                     (
-                        finite(curvature.lattice_error(p) * scale),
+                        // Kept with the lattice: stage 0 scales it for each inner level.
+                        finite(curvature.inner_error(p) * scale),
                         edges.map(|d| finite(d * scale / 8.0)),
                         largest,
                         kept,

@@ -41,9 +41,15 @@ pub(crate) struct Curvature {
     /// [`Curvature::spread`].
     spread: f64,
     /// The inner lattice error last computed on this lattice and the inner level it was for
-    /// ([`Curvature::inner_error`]); level 0: none.
+    /// ([`Curvature::inner_error`]); level 0: none; level [`EVERY_POINT`]: the largest error
+    /// over every interior point, unscaled, which gives the error of every inner level at or
+    /// above the lattice's.
     inner: (u32, f64),
 }
+
+/// The level [`Curvature`] keeps its inner lattice error for when it holds the worst over every
+/// interior point (see [`Curvature::inner_error`]).
+const EVERY_POINT: u32 = u32::MAX;
 
 /// The largest of `|½ Σ_{a<b} w_a w_b|` over the sample weights: the most a unit change of
 /// every `Q_ab` changes a sample's predicted error (at the centroid, `½ · 3 · (1/3)²`).
@@ -210,7 +216,23 @@ impl Curvature {
     /// lattice and level: a triangle checked again with only its edge counts raised (most of
     /// the checks while the counts settle, restored by [`Curvature::restore`]) has the same
     /// inner lattice error, bit for bit, and the model's boundary part is all that changes.
+    ///
+    /// An inner level `m` at or above the lattice's own reads every interior point (each is at
+    /// least one level-`m` step in from the edges), so [`Curvature::lattice_error`] is
+    /// `(L/m)²` times one maximum for all of them: that maximum is what is kept, and the
+    /// product is taken as `lattice_error` takes it, so a triangle whose inner level is raised
+    /// on the same lattice (the probe's, while the counts settle on it) scales the kept
+    /// maximum instead of reading the lattice again.
     pub fn inner_error(&mut self, m: u32) -> f64 {
+        let l = self.level;
+        if m >= l {
+            if self.inner.0 != EVERY_POINT {
+                // At its own level the scale is 1: the maximum itself, bit for bit.
+                self.inner = (EVERY_POINT, self.lattice_error(l));
+            }
+            let scale = (f64::from(l) / f64::from(m)).powi(2);
+            return scale * self.inner.1;
+        }
         if self.inner.0 != m {
             self.inner = (m, self.lattice_error(m));
         }
@@ -878,6 +900,35 @@ mod tests {
             skipped > 10 && kept > 10,
             "{skipped} pass the bound, {kept} do not"
         );
+    }
+
+    /// The inner lattice error of an inner level at or above the lattice's, taken from the one
+    /// maximum over every interior point, kept and restored, is [`Curvature::lattice_error`]'s
+    /// bit for bit; below the lattice's level it is computed as before.
+    #[test]
+    fn the_inner_error_above_the_lattice_level_is_its_lattice_error() {
+        for f in smooth_fields() {
+            for level in [6, 9, 16] {
+                let points = height_lattice(level, 1.0, &f);
+                let plain = curvature(&points, level);
+                let mut c = curvature(&points, level);
+                let mut kept = Vec::new();
+                for m in [level, level + 1, 17, 2 * level + 3, 4, level - 1, level + 2] {
+                    let mut restored = Curvature::default();
+                    if !kept.is_empty() {
+                        assert!(restored.restore(level, &kept));
+                        c = restored;
+                    }
+                    assert_eq!(
+                        c.inner_error(m).to_bits(),
+                        plain.lattice_error(m).to_bits(),
+                        "level {level}, inner {m}"
+                    );
+                    kept.clear();
+                    c.keep(&mut kept);
+                }
+            }
+        }
     }
 
     /// `q` spread over magnitudes and signs, from a fixed-seed generator, with the cases
