@@ -24,7 +24,7 @@ use crate::mesh::TriMesh;
 use crate::options::Options;
 use crate::sharpness::{AssetSharpness, EdgeParams, EffectiveH, MeshContext, PrimitiveContext};
 use crate::surface::flat::flat_is_exact;
-use crate::surface::{scheme, FlatSurface, Scheme, Surface};
+use crate::surface::{scheme, FlatSurface, G2Surface, Scheme, Surface};
 use crate::topology::Topology;
 use crate::{normals, optimize};
 
@@ -254,7 +254,9 @@ pub fn smooth_mesh(
     // Where no width is read the flat surface is the one `surface_for` would take (the same
     // test decided it), without testing every normal again.
     let (surface, surface_warnings) = if widths_read {
-        surface_for(options, corners_only, &mesh, &topo, &effective)
+        // One uniform level with nothing measured reads the surface once, in triangle order.
+        let one_pass = chain.is_empty() && !options.adaptive() && !options.report_figures;
+        surface_for(options, corners_only, one_pass, &mesh, &topo, &effective)
     } else {
         let flat: Box<dyn Surface> = Box::new(FlatSurface::new(&mesh));
         (flat, Vec::new())
@@ -493,14 +495,21 @@ fn lap(clock: &Instant, before: f64) -> f64 {
     clock.elapsed().as_secs_f64() - before
 }
 
-/// The surface the options ask for, with the warnings its construction gave.
+/// The surface the options ask for, with the warnings its construction gave. `one_pass`: the
+/// caller reads it once, in triangle order (one uniform level); the G² surface may then make
+/// its patches on demand ([`G2Surface::with_nets_for_one_pass`]), with the same output bits.
 pub(super) fn build_surface<'a>(
     options: &Options,
+    one_pass: bool,
     mesh: &'a TriMesh,
     topo: &'a Topology,
     h: &'a EffectiveH,
 ) -> (Box<dyn Surface + 'a>, Vec<scheme::Warning>) {
     let params = options.scheme_params();
+    if one_pass && options.scheme == Scheme::G2 {
+        let surface = G2Surface::with_nets_for_one_pass(mesh, topo, h, params.profile, params.nets);
+        return (Box::new(surface), Vec::new());
+    }
     scheme::build_surface(options.scheme, mesh, topo, h, &params)
 }
 
@@ -516,6 +525,7 @@ pub(super) fn build_surface<'a>(
 pub(super) fn surface_for<'a>(
     options: &Options,
     corners_only: bool,
+    one_pass: bool,
     mesh: &'a TriMesh,
     topo: &'a Topology,
     h: &'a EffectiveH,
@@ -523,7 +533,7 @@ pub(super) fn surface_for<'a>(
     if takes_flat_surface(options, corners_only, mesh) {
         return (Box::new(FlatSurface::new(mesh)), Vec::new());
     }
-    build_surface(options, mesh, topo, h)
+    build_surface(options, one_pass, mesh, topo, h)
 }
 
 /// Whether [`surface_for`] takes the flat surface for `mesh`: corners alone are read, the

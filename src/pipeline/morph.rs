@@ -57,7 +57,8 @@ pub fn targets(
         let moved = displaced(mesh, prepared, t);
         // At a uniform level 1 the targets' output is their corners, as the base mesh's.
         let corners_only = matches!(density, Density::Level(1));
-        let (surface, said) = super::mesh_job::surface_for(options, corners_only, &moved, topo, h);
+        let (surface, said) =
+            super::mesh_job::surface_for(options, corners_only, false, &moved, topo, h);
         warnings.extend(said.into_iter().map(|w| (t, w)));
         let dense = density
             .tessellate(&moved, topo, h, surface.as_ref(), groups)

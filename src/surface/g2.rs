@@ -62,6 +62,24 @@ const _: () = assert!(std::mem::size_of::<Patch>() == 88);
 /// Control points of a net that are not corners (the corners are slots 0, 1, 2).
 const INNER: usize = 7;
 
+/// Where the surface takes each triangle's [`Patch`] from when its net is rebuilt.
+#[derive(Debug)]
+enum Patches {
+    /// Made for every triangle when the surface is built (88 bytes each), and rewritten where
+    /// an unblended edge's triangles share one curve.
+    Stored(Vec<Patch>),
+    /// Made again from the triangle's corners by this rule each time its net is rebuilt: the
+    /// patch [`Patches::Stored`] would hold, since no edge curve is shared
+    /// ([`on_demand_pays`]).
+    ///
+    /// Why: at level 2 every net is read in the one pass of the tessellator, in triangle order,
+    /// and the memo of rebuilt nets (`net_memo`) keeps it from its first use to its last, so
+    /// it is made about once either way. Storing it first cost a pass of its own over the
+    /// corners and 88 MB (each page a fault) on a million triangles, and it was then rebuilt
+    /// from what was stored.
+    OnDemand(Nets),
+}
+
 /// The point of the flat net (the triangle itself as a cubic) in slot `m`:
 /// `(i·p0 + j·p1 + k·p2)/3` for the exponents `(i, j, k)` of [`IJK`](super::pn::IJK).
 ///
@@ -126,7 +144,7 @@ pub struct G2Surface<'a> {
     topo: &'a Topology,
     /// One width per welded edge; `None`: 0 on every edge (PN triangles).
     h: Option<&'a [f64]>,
-    patches: Vec<Patch>,
+    patches: Patches,
     profile: Profile,
     patterns: PatternCache,
     /// The weights of the scattered point sets asked for again and again ([`point_sets`]).
@@ -163,6 +181,27 @@ impl<'a> G2Surface<'a> {
         Self::build(mesh, topo, Some(h), profile, nets_rule)
     }
 
+    /// [`G2Surface::with_nets`] for a caller that reads the surface in one pass over the
+    /// triangles in order, as the uniform tessellator does: where that lets each net be made
+    /// about once without storing it, no patch is stored (made on demand). Every point
+    /// has the same bits as on the surface [`G2Surface::with_nets`] builds; only the cost
+    /// differs, and a caller that reads triangles in another order or more than once (a
+    /// tolerance's probes, a report's figures, a chain of levels) should take that one.
+    ///
+    /// # Panics
+    /// If `h`, `topo` and `mesh` do not belong together (a caller bug).
+    pub fn with_nets_for_one_pass(
+        mesh: &'a TriMesh,
+        topo: &'a Topology,
+        h: &'a EffectiveH,
+        profile: Profile,
+        nets_rule: Nets,
+    ) -> Self {
+        super::assert_belong_together(mesh, topo, Some(h));
+        let on_demand = on_demand_pays(topo, h);
+        Self::assemble(mesh, topo, Some(h), profile, nets_rule, on_demand)
+    }
+
     /// [`G2Surface::with_nets`] with the widths checked; `h`: `None` for 0 on every edge.
     fn build(
         mesh: &'a TriMesh,
@@ -171,18 +210,38 @@ impl<'a> G2Surface<'a> {
         profile: Profile,
         nets_rule: Nets,
     ) -> Self {
-        // Built in place, in the final array, in one pass: no per-triangle corner or net arrays
-        // beside it.
-        let patches: Vec<Patch> = (0..mesh.triangles.len())
-            .into_par_iter()
-            .map(|t| {
-                let (position, normal) = corners(mesh, mesh.triangles[t]);
-                Patch {
-                    inner: offsets(&nets_rule.net(position, normal)),
-                    as_stored: 0,
-                }
-            })
-            .collect();
+        Self::assemble(mesh, topo, h, profile, nets_rule, false)
+    }
+
+    /// The surface with its patches stored, or made on demand when `on_demand` (which the
+    /// caller has found to pay, and which requires every edge curve to be its own triangle's:
+    /// see [`on_demand_pays`]).
+    fn assemble(
+        mesh: &'a TriMesh,
+        topo: &'a Topology,
+        h: Option<&'a [f64]>,
+        profile: Profile,
+        nets_rule: Nets,
+        on_demand: bool,
+    ) -> Self {
+        let patches = if on_demand {
+            Patches::OnDemand(nets_rule)
+        } else {
+            // Built in place, in the final array, in one pass: no per-triangle corner or net
+            // arrays beside it.
+            Patches::Stored(
+                (0..mesh.triangles.len())
+                    .into_par_iter()
+                    .map(|t| {
+                        let (position, normal) = corners(mesh, mesh.triangles[t]);
+                        Patch {
+                            inner: offsets(&nets_rule.net(position, normal)),
+                            as_stored: 0,
+                        }
+                    })
+                    .collect(),
+            )
+        };
         let mut surface = G2Surface {
             mesh,
             topo,
@@ -195,7 +254,14 @@ impl<'a> G2Surface<'a> {
         };
         debug_assert!((0..mesh.triangles.len()).all(|t| (0..3)
             .all(|k| surface.widths(t)[k] == 0.0 || topo.neighbour(TriId(t as u32), k).is_some())));
-        share_unblended_edge_curves(mesh, topo, h, &mut surface.patches, nets_rule);
+        match &mut surface.patches {
+            Patches::Stored(patches) => {
+                share_unblended_edge_curves(mesh, topo, h, patches, nets_rule)
+            }
+            Patches::OnDemand(_) => {
+                debug_assert!(h.is_some_and(|h| !has_unblended_shared_edge(topo, h)))
+            }
+        }
         surface
     }
 
@@ -212,7 +278,10 @@ impl<'a> G2Surface<'a> {
     /// pattern cache, shared by all triangles, and the borrowed mesh and topology are not
     /// counted).
     pub fn heap_bytes(&self) -> usize {
-        self.patches.capacity() * std::mem::size_of::<Patch>()
+        match &self.patches {
+            Patches::Stored(patches) => patches.capacity() * std::mem::size_of::<Patch>(),
+            Patches::OnDemand(_) => 0,
+        }
     }
 
     /// The neighbour's net across edge `k` of triangle `tri` in `tri`'s barycentrics,
@@ -275,7 +344,10 @@ impl<'a> G2Surface<'a> {
     /// which has the same bits (`net_memo`).
     #[inline]
     fn with_local<R>(&self, tri: usize, read: impl FnOnce(&Local) -> R) -> R {
-        let rebuild = |out: &mut Local| local_into(self.mesh, tri, &self.patches[tri], out);
+        let rebuild = |out: &mut Local| match &self.patches {
+            Patches::Stored(patches) => local_into(self.mesh, tri, &patches[tri], out),
+            Patches::OnDemand(rule) => made_local_into(self.mesh, tri, *rule, out),
+        };
         net_memo::with_local(self.memo_owner, tri, rebuild, read)
     }
 
@@ -589,6 +661,82 @@ fn local_into(mesh: &TriMesh, tri: usize, patch: &Patch, out: &mut Local) {
     onto_tangent_planes(net, &normal, patch.as_stored);
     out.normal = normal;
 }
+
+/// [`local_into`] of the patch [`Patches::Stored`] holds for `tri` where no edge curve is
+/// shared: its net made by `rule` from its corners, each point off the corners rounded to its
+/// `f32` offset and rebuilt from it, with the same operations in the same order as
+/// [`offsets`] then [`local_into`], so with the same bits. The corners are read and each flat
+/// point is computed once for both halves.
+#[inline]
+fn made_local_into(mesh: &TriMesh, tri: usize, rule: Nets, out: &mut Local) {
+    let (position, normal) = corners(mesh, mesh.triangles[tri]);
+    let made = rule.net(position, normal);
+    for (x, coord) in out.net.iter_mut().enumerate() {
+        let p = coordinate(&position, x);
+        coord[..3].copy_from_slice(&p);
+        for (m, point) in coord[3..].iter_mut().enumerate() {
+            let flat = flat_point(p, 3 + m);
+            let offset = (made[3 + m][x] - flat) as f32;
+            *point = flat + f64::from(offset);
+        }
+    }
+    onto_tangent_planes(&mut out.net, &normal, 0);
+    out.normal = normal;
+}
+
+/// Whether some edge with two or more triangles and two distinct ends is not blended: there
+/// [`share_unblended_edge_curves`] may make its triangles share one curve, which a patch made
+/// on demand would not.
+fn has_unblended_shared_edge(topo: &Topology, h: &[f64]) -> bool {
+    h.par_iter().enumerate().any(|(e, &h)| {
+        h == 0.0 && {
+            let edge = topo.edge(EdgeId(e as u32));
+            edge.tris.len() >= 2 && edge.verts[0] != edge.verts[1]
+        }
+    })
+}
+
+/// Whether the patches of a surface read in one pass in triangle order are better made on
+/// demand ([`Patches::OnDemand`]) than stored: every edge curve is its own triangle's, and the
+/// neighbours across blended edges lie close enough in triangle order that the memo of
+/// rebuilt nets keeps each net from its first use to its last.
+///
+/// A net the memo has lost is made again whole (about four times the cost of a rebuild from
+/// a stored patch), so the neighbours must be near: at most one blended edge in
+/// [`FAR_SHARE`] may join triangles half the memo's size apart or more. The bench icospheres
+/// have 0.4% (1M) and 1.4% (100k) of neighbours farther than the whole memo's size.
+fn on_demand_pays(topo: &Topology, h: &[f64]) -> bool {
+    if has_unblended_shared_edge(topo, h) {
+        return false;
+    }
+    // A sample of the triangles tells as well as all of them, at a seventh of the cost.
+    let (far, blended) = (0..topo.tri_edges.len())
+        .into_par_iter()
+        .step_by(SAMPLE_STRIDE)
+        .map(|t| {
+            let mut counts = (0usize, 0usize);
+            for (k, e) in topo.tri_edges[t].iter().enumerate() {
+                if h[e.0 as usize] > 0.0 {
+                    counts.1 += 1;
+                    let n = topo
+                        .neighbour(TriId(t as u32), k)
+                        .expect("blended edges are interior");
+                    if (n.tri.0 as usize).abs_diff(t) >= net_memo::SLOTS / 2 {
+                        counts.0 += 1;
+                    }
+                }
+            }
+            counts
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    far * FAR_SHARE <= blended
+}
+
+/// See [`on_demand_pays`].
+const FAR_SHARE: usize = 32;
+
+/// [`on_demand_pays`] counts the neighbours of every this many triangles.
+const SAMPLE_STRIDE: usize = 7;
 
 /// Edge control point `slot` of triangle `tri`'s `patch`, as [`local`] rebuilds it.
 fn edge_point(mesh: &TriMesh, tri: usize, patch: &Patch, slot: usize) -> DVec3 {

@@ -43,6 +43,7 @@ mod sharpness_support;
 mod stream_output;
 mod support;
 mod surface_continuity;
+mod surface_one_pass;
 mod surface_pn;
 mod surface_props;
 mod surface_shape;
