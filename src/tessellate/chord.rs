@@ -183,6 +183,33 @@ pub(crate) fn pattern_error(
     worst
 }
 
+/// The points of source triangle `tri`'s `pattern` in the pattern's numbering (corners, each
+/// edge's samples, the interior, each as the lattice parts list them), evaluated on its own
+/// side into `points` (cleared first).
+fn evaluate_pattern_points(
+    surface: &dyn Surface,
+    tri: usize,
+    pattern: &Pattern,
+    points: &mut Vec<SurfacePoint>,
+) {
+    points.clear();
+    surface.evaluate_points(
+        tri,
+        &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        points,
+    );
+    for k in 0..3 {
+        let n = pattern.key.edges[k];
+        if n > 1 {
+            surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), points);
+        }
+    }
+    if pattern.key.inner >= 3 {
+        surface.evaluate_lattice_part(tri, pattern.key.inner, LatticePart::Interior, points);
+    }
+    debug_assert_eq!(points.len(), pattern.lattice.len());
+}
+
 /// The chord error of source triangle `tri` cut by `pattern`, its vertices evaluated on its
 /// own side (equal to the written ones up to rounding), by part: measured without
 /// tessellating.
@@ -192,29 +219,7 @@ pub(crate) fn measured_error(
     pattern: &Pattern,
     samples: &mut Samples,
 ) -> PatternError {
-    // The pattern's points in its numbering: corners, each edge's samples, the interior, each
-    // as the lattice parts list them.
-    samples.points.clear();
-    surface.evaluate_points(
-        tri,
-        &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-        &mut samples.points,
-    );
-    for k in 0..3 {
-        let n = pattern.key.edges[k];
-        if n > 1 {
-            surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut samples.points);
-        }
-    }
-    if pattern.key.inner >= 3 {
-        surface.evaluate_lattice_part(
-            tri,
-            pattern.key.inner,
-            LatticePart::Interior,
-            &mut samples.points,
-        );
-    }
-    debug_assert_eq!(samples.points.len(), pattern.lattice.len());
+    evaluate_pattern_points(surface, tri, pattern, &mut samples.points);
     let mut vertices = std::mem::take(&mut samples.vertices);
     vertices.clear();
     vertices.extend(samples.points.iter().map(|p| written(p.position)));
@@ -234,27 +239,7 @@ pub(crate) fn candidate_errors(
     candidates: &[[u32; 3]],
     samples: &mut Samples,
 ) -> Vec<(f64, f64)> {
-    samples.points.clear();
-    surface.evaluate_points(
-        tri,
-        &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-        &mut samples.points,
-    );
-    for k in 0..3 {
-        let n = pattern.key.edges[k];
-        if n > 1 {
-            surface.evaluate_lattice_part(tri, n, LatticePart::Edge(k as u8), &mut samples.points);
-        }
-    }
-    if pattern.key.inner >= 3 {
-        surface.evaluate_lattice_part(
-            tri,
-            pattern.key.inner,
-            LatticePart::Interior,
-            &mut samples.points,
-        );
-    }
-    debug_assert_eq!(samples.points.len(), pattern.lattice.len());
+    evaluate_pattern_points(surface, tri, pattern, &mut samples.points);
     let vertices: Vec<DVec3> = samples.points.iter().map(|p| written(p.position)).collect();
     samples.barys.clear();
     for t in candidates {
