@@ -173,6 +173,13 @@ pub fn output_size(tris: usize, level: u32) -> (u64, u64) {
 /// enough that two threads stay balanced on a few thousand input triangles.
 const BLOCK_TRIANGLES: usize = 16 * 1024;
 
+/// Blocks per thread at least, so that threads stay balanced when a group has few output
+/// triangles (see [`block_ranges`]).
+const BLOCKS_PER_THREAD: usize = 4;
+
+/// Source triangles per block at least: below, a block's setup is no longer noise.
+const MIN_BLOCK_TRIS: usize = 64;
+
 /// Tessellates `groups` (contiguous triangle ranges of `mesh`, one per output primitive) at
 /// level `level` (≥ 1). `h` is the blend width per welded edge, used only to decide which
 /// interior edges are creases (h = 0) and get split output vertices.
@@ -357,9 +364,18 @@ fn tessellate_group(
 }
 
 /// The blocks of a group of `len` source triangles at level `n`: consecutive triangle ranges
-/// of about [`BLOCK_TRIANGLES`] output triangles.
+/// of about [`BLOCK_TRIANGLES`] output triangles, and at least [`BLOCKS_PER_THREAD`] per
+/// thread where the group is too small for that (but no fewer than [`MIN_BLOCK_TRIS`] source
+/// triangles each). Without the second bound a 10k-triangle mesh at level 2 made three blocks
+/// (4,096, 4,096 and 1,488 triangles), so one thread did two thirds of the work, and at level
+/// 1 one block, which one thread did alone. Blocks only cut the output buffers: how many
+/// there are changes no output bit.
 fn block_ranges(n: u32, len: usize) -> impl Iterator<Item = Range<usize>> {
-    let tris_per_block = (BLOCK_TRIANGLES / (n * n) as usize).max(1);
+    let by_output = (BLOCK_TRIANGLES / (n * n) as usize).max(1);
+    let by_threads = len
+        .div_ceil(BLOCKS_PER_THREAD * rayon::current_num_threads())
+        .max(MIN_BLOCK_TRIS);
+    let tris_per_block = by_output.min(by_threads);
     (0..len)
         .step_by(tris_per_block)
         .map(move |start| start..(start + tris_per_block).min(len))
@@ -537,5 +553,46 @@ fn tessellate_block(shared: &Shared<'_>, mut block: Block<'_>) {
                 source,
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Consecutive ranges from 0 to `len`, none empty.
+    fn assert_cover(blocks: &[Range<usize>], len: usize) {
+        assert_eq!(blocks.first().map_or(0, |b| b.start), 0);
+        assert_eq!(blocks.last().map_or(0, |b| b.end), len);
+        assert!(blocks.windows(2).all(|w| w[0].end == w[1].start));
+        assert!(blocks.iter().all(|b| !b.is_empty()));
+    }
+
+    #[test]
+    fn small_groups_at_low_levels_get_blocks_for_every_thread() {
+        let threads = rayon::current_num_threads();
+        for (n, len) in [(1, 9_680), (2, 9_680), (4, 9_680), (2, 1_000), (16, 9_680)] {
+            let blocks: Vec<_> = block_ranges(n, len).collect();
+            assert_cover(&blocks, len);
+            let wanted = (BLOCKS_PER_THREAD * threads).min(len / MIN_BLOCK_TRIS);
+            assert!(
+                blocks.len() >= wanted,
+                "level {n}, {len} triangles: {blocks:?}"
+            );
+            let by_output = BLOCK_TRIANGLES / (n * n) as usize;
+            assert!(blocks.iter().all(|b| b.len() <= by_output.max(1)));
+        }
+    }
+
+    #[test]
+    fn large_groups_keep_blocks_of_the_output_size() {
+        // About 16k output triangles a block at level 2, unless there are so many threads
+        // that the blocks per thread ask for smaller ones.
+        let len = 1_003_520;
+        let blocks: Vec<_> = block_ranges(2, len).collect();
+        assert_cover(&blocks, len);
+        let by_threads = len.div_ceil(BLOCKS_PER_THREAD * rayon::current_num_threads());
+        let size = (BLOCK_TRIANGLES / 4).min(by_threads);
+        assert!(blocks[..blocks.len() - 1].iter().all(|b| b.len() == size));
     }
 }
