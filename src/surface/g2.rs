@@ -16,13 +16,14 @@ use super::pattern::{
     LANES,
 };
 use super::pn::{Net, B111, NEAR};
-use super::{LatticePart, Profile, Surface, SurfacePoint};
+use super::{lattice_len, LatticePart, Profile, Surface, SurfacePoint};
 use crate::mesh::TriMesh;
 use crate::sharpness::EffectiveH;
 use crate::topology::{Edge, EdgeId, Topology, TriId};
 
 mod point_sets;
 mod positions;
+mod refine;
 
 /// Everything one triangle needs at evaluation time that the mesh and its topology do not
 /// already hold: 88 bytes, one allocation for the whole mesh.
@@ -149,6 +150,8 @@ pub struct G2Surface<'a> {
     patterns: PatternCache,
     /// The weights of the scattered point sets asked for again and again ([`point_sets`]).
     point_sets: point_sets::PointSets,
+    /// The weights of the points a lattice adds to the one of half its level ([`refine`]).
+    odd_points: refine::OddPointsCache,
     /// This surface's tag in the per-thread memo of rebuilt nets ([`net_memo`]).
     memo_owner: u64,
 }
@@ -250,6 +253,7 @@ impl<'a> G2Surface<'a> {
             profile,
             patterns: PatternCache::default(),
             point_sets: point_sets::PointSets::new(point_sets::MAX_SETS),
+            odd_points: refine::OddPointsCache::new(refine::MAX_LEVELS),
             memo_owner: net_memo::new_owner(),
         };
         debug_assert!((0..mesh.triangles.len()).all(|t| (0..3)
@@ -880,6 +884,23 @@ impl Surface for G2Surface<'_> {
         });
     }
 
+    /// The even points copied from `coarse`, the others through the patterns of the points a
+    /// lattice adds to the one of half its level (`g2::refine`).
+    fn evaluate_lattice_positions_on_edges_refining(
+        &self,
+        tri: usize,
+        level: u32,
+        coarse: &[SurfacePoint],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        if level % 2 != 0 || coarse.len() != lattice_len(level / 2) {
+            return self.evaluate_lattice_positions_on_edges(tri, level, out);
+        }
+        PartEvaluation::set_up(self, tri, false, |evaluation| {
+            evaluation.refined_lattice_with_edge_positions(level, coarse, out);
+        });
+    }
+
     fn evaluate_points_positions_first(
         &self,
         tri: usize,
@@ -953,31 +974,8 @@ trait PointSink {
     fn put(&mut self, target: u32, point: SurfacePoint);
 
     /// The points of `lanes` (targets [`Lanes::PADDING`] unused), from `own` and `across` as
-    /// [`G2Surface::combine`] takes them.
-    fn block<const L: usize, N: LaneNet<L>>(
-        &mut self,
-        normal: &[DVec3; 3],
-        lanes: &Lanes<L>,
-        own: &N,
-        across: Option<&N>,
-        split: Option<&Split>,
-        edge_rows: EdgeRows,
-    );
-}
-
-/// Every point whole, in the part's order.
-struct Points<'o>(&'o mut [SurfacePoint]);
-
-impl PointSink for Points<'_> {
-    fn len(&self) -> usize {
-        self.0.len()
-    }
-
-    #[inline(always)]
-    fn put(&mut self, target: u32, point: SurfacePoint) {
-        self.0[target as usize] = point;
-    }
-
+    /// [`G2Surface::combine`] takes them: by default each whole, given to
+    /// [`PointSink::put`].
     #[inline(always)]
     fn block<const L: usize, N: LaneNet<L>>(
         &mut self,
@@ -991,9 +989,23 @@ impl PointSink for Points<'_> {
         let points = G2Surface::combine(normal, lanes, own, across, split, edge_rows);
         for (&target, p) in lanes.target.iter().zip(points) {
             if target != Lanes::<1>::PADDING {
-                self.0[target as usize] = p;
+                self.put(target, p);
             }
         }
+    }
+}
+
+/// Every point whole, in the part's order.
+struct Points<'o>(&'o mut [SurfacePoint]);
+
+impl PointSink for Points<'_> {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    #[inline(always)]
+    fn put(&mut self, target: u32, point: SurfacePoint) {
+        self.0[target as usize] = point;
     }
 }
 
@@ -1225,6 +1237,17 @@ impl Surface for PnSurface<'_> {
         out: &mut Vec<SurfacePoint>,
     ) {
         self.0.evaluate_lattice_positions_on_edges(tri, level, out)
+    }
+
+    fn evaluate_lattice_positions_on_edges_refining(
+        &self,
+        tri: usize,
+        level: u32,
+        coarse: &[SurfacePoint],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        self.0
+            .evaluate_lattice_positions_on_edges_refining(tri, level, coarse, out)
     }
 
     fn evaluate_points_positions_first(

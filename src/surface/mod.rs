@@ -164,6 +164,24 @@ pub trait Surface: Sync {
         self.evaluate_lattice(tri, level, out);
     }
 
+    /// [`Surface::evaluate_lattice_positions_on_edges`] of the level-`level` lattice, given
+    /// `coarse`, what that call gave for the level-`level / 2` lattice of the same triangle:
+    /// the same points, bit for bit, where it gives them (positions everywhere, the normals of
+    /// the corners and interior points). The coarse lattice is the fine one's even points
+    /// `(2i, 2j)`, at the same barycentrics bit for bit (`2i/2n` and `i/n` are one quotient,
+    /// rounded once), so a surface may copy them and evaluate the other three quarters alone.
+    /// A `coarse` that is not such a lattice (`level` odd, or the wrong length) is not read.
+    fn evaluate_lattice_positions_on_edges_refining(
+        &self,
+        tri: usize,
+        level: u32,
+        coarse: &[SurfacePoint],
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        let _ = coarse;
+        self.evaluate_lattice_positions_on_edges(tri, level, out);
+    }
+
     /// [`Surface::evaluate_points`] for a caller that reads only the positions of the first
     /// `positions_only` points: every position, and the normals from point `positions_only`
     /// on, are those [`Surface::evaluate_points`] gives, bit for bit; the first points'

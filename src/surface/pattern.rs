@@ -245,13 +245,19 @@ impl Pattern {
     /// for a set of scattered points asked for on many triangles: the same weights as at a
     /// lattice's points, so its sums equal [`PointWeights::at`]'s evaluated one by one.
     pub fn at_points(barys: &[[f64; 3]], h: [f64; 3], profile: Profile) -> Pattern {
-        Pattern::build(
-            barys.iter().copied(),
-            barys.len(),
-            LatticePart::All,
-            h,
-            profile,
-        )
+        Pattern::at_part_points(barys, LatticePart::All, h, profile)
+    }
+
+    /// [`Pattern::at_points`] for points that all lie on `part` of a lattice: on an edge part,
+    /// the sums then leave out the control points whose weights are all zero there
+    /// ([`EdgeRows`]), as the part's own pattern does.
+    pub fn at_part_points(
+        barys: &[[f64; 3]],
+        part: LatticePart,
+        h: [f64; 3],
+        profile: Profile,
+    ) -> Pattern {
+        Pattern::build(barys.iter().copied(), barys.len(), part, h, profile)
     }
 
     /// The pattern of the `len` points `barys`, which are `part`'s (for the edge rows).

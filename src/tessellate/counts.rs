@@ -26,6 +26,7 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 use rayon::prelude::*;
 
@@ -317,6 +318,9 @@ impl ChordErrors {
         // Per triangle, the packed key of the pattern whose last check at its own resolution
         // showed the finer check would pass too (0: none).
         let resolved: Vec<AtomicU64> = (0..counts.inner.len()).map(|_| AtomicU64::new(0)).collect();
+        // Per triangle, the last lattice stage 1 read while it did not resolve: stage 2 checks
+        // it on the lattice of twice that level, whose even points these are (`Coarse`).
+        let coarse = Coarse::new(counts.inner.len());
         for factor in [0, 1, 2] {
             counts.raise_until_met(
                 topo,
@@ -342,7 +346,12 @@ impl ChordErrors {
                     if read {
                         points.clear();
                         // Second differences are taken along interior points' normals only.
-                        surface.evaluate_lattice_positions_on_edges(tri, level, points);
+                        match coarse.take(tri, factor, level) {
+                            Some(half) => surface.evaluate_lattice_positions_on_edges_refining(
+                                tri, level, &half, points,
+                            ),
+                            None => surface.evaluate_lattice_positions_on_edges(tri, level, points),
+                        }
                         curvature.read(points, level);
                         // At the pattern's own inner level the lattice's interior is the
                         // output's, if the counts stay.
@@ -372,6 +381,11 @@ impl ChordErrors {
                         let finer = model.bound(&error, curvature.spread());
                         let skip = if finer.within(predicted) { key } else { 0 };
                         resolved[tri].store(skip, Ordering::Relaxed);
+                        let twice = check_level(model.inner(), 2) == 2 * level;
+                        coarse.note(
+                            tri,
+                            (skip == 0 && twice).then_some((level, read, &points[..])),
+                        );
                     }
                     // A failing triangle is checked again next round; a passing one may be
                     // when a neighbour is raised. The latter keeps its lattice's second
@@ -445,6 +459,63 @@ impl ChordErrors {
             }
         }
         best
+    }
+}
+
+/// The lattices stage 1 of [`ChordErrors::refine_to_tolerance`] read on triangles it left for
+/// stage 2, which reads the lattice of twice their level: its even points are those of the
+/// kept one, bit for bit ([`Surface::evaluate_lattice_positions_on_edges_refining`]), a
+/// quarter of its points (on the 10k icosphere at the error level 16 reaches, 212,000 of
+/// stage 2's 847,020). Only the last check of each triangle decides: a triangle stage 1
+/// resolves frees what it kept, so what is held is the lattices of the triangles stage 2 will
+/// check (1,420 there, about 11 MB), and none once stage 2 has read them.
+struct Coarse(Vec<Mutex<Option<KeptLattice>>>);
+
+/// A whole lattice as a check read it, and its level.
+type KeptLattice = (u32, Vec<SurfacePoint>);
+
+impl Coarse {
+    fn new(triangles: usize) -> Coarse {
+        Coarse((0..triangles).map(|_| Mutex::new(None)).collect())
+    }
+
+    /// After a stage-1 check of `tri`: `Some((level, read, points))` when stage 2 will check
+    /// it at twice `level`, `points` the level-`level` lattice if this check `read` it
+    /// (else the one kept, if of that level, stays); `None` when stage 2 will not check it at
+    /// twice this level, which frees what was kept.
+    fn note(&self, tri: usize, kept: Option<(u32, bool, &[SurfacePoint])>) {
+        let mut slot = self.0[tri].lock().expect("no check panics while keeping");
+        match kept {
+            Some((level, true, points)) => match slot.as_mut() {
+                Some((l, held)) => {
+                    *l = level;
+                    held.clear();
+                    held.extend_from_slice(points);
+                }
+                None => *slot = Some((level, points.to_vec())),
+            },
+            Some((level, false, _)) => {
+                if slot.as_ref().is_some_and(|(l, _)| *l != level) {
+                    *slot = None;
+                }
+            }
+            None => *slot = None,
+        }
+    }
+
+    /// For a stage-2 read of `tri`'s level-`level` lattice, the kept lattice of half its
+    /// level, if any; what is kept is freed either way (a later check of the triangle is at
+    /// another level, or restores what it read).
+    fn take(&self, tri: usize, factor: u32, level: u32) -> Option<Vec<SurfacePoint>> {
+        if factor != 2 {
+            return None;
+        }
+        let kept = self.0[tri]
+            .lock()
+            .expect("no check panics while keeping")
+            .take();
+        kept.filter(|(l, _)| 2 * l == level)
+            .map(|(_, points)| points)
     }
 }
 

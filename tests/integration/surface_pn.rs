@@ -274,6 +274,35 @@ fn bits(p: DVec3) -> [u64; 3] {
     p.to_array().map(f64::to_bits)
 }
 
+/// The check at twice a pattern's resolution copies the even points of its lattice from the
+/// lattice at the pattern's own level: the lattice it gives must be the one evaluated whole,
+/// bit for bit (every position, the corners' and interior points' normals), on split normals
+/// and with some edges at h = 0; a coarse lattice of the wrong level is not read.
+#[test]
+fn a_lattice_refined_from_half_its_level_equals_it_bit_for_bit() {
+    random_h_surfaces(&mut Lcg(47), |s, mesh, _| {
+        for t in 0..mesh.triangles.len() {
+            for level in [4, 6, 12, 26] {
+                let (mut direct, mut coarse, mut refined) = (Vec::new(), Vec::new(), Vec::new());
+                s.evaluate_lattice_positions_on_edges(t, level, &mut direct);
+                s.evaluate_lattice_positions_on_edges(t, level / 2, &mut coarse);
+                s.evaluate_lattice_positions_on_edges_refining(t, level, &coarse, &mut refined);
+                assert_eq!(direct.len(), refined.len());
+                for (index, (d, r)) in direct.iter().zip(&refined).enumerate() {
+                    let what = format!("triangle {t} level {level} point {index}");
+                    assert_eq!(bits(r.position), bits(d.position), "{what}");
+                    assert_eq!(bits(r.normal), bits(d.normal), "{what}");
+                }
+                let mut unread = Vec::new();
+                s.evaluate_lattice_positions_on_edges_refining(t, level + 1, &coarse, &mut unread);
+                direct.clear();
+                s.evaluate_lattice_positions_on_edges(t, level + 1, &mut direct);
+                assert_eq!(unread, direct, "triangle {t} level {}", level + 1);
+            }
+        }
+    });
+}
+
 /// The chord error checks read positions alone where they read no normal (a lattice's edge
 /// points, the vertices of the triangles they measure), summed without the tangents: every
 /// position, and every normal they do read, must be what the whole evaluation gives, bit for
