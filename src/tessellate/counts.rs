@@ -365,18 +365,21 @@ impl ChordErrors {
                     // value of failing ones only; stage 1 also asks whether its bound of the
                     // finer check passes, which parts under `skip_floors` do whatever their
                     // value.
-                    let error = if factor == 1 {
-                        let inner = curvature.inner_error(model.inner());
+                    let inner = curvature.inner_error(model.inner());
+                    let deciding = DecidingParts::new(model.key(), inner, predicted, cap);
+                    let floors = if factor == 1 {
                         // The spread is needed where this check passes, or may pass when
                         // restored with its inner level as it is (its inner lattice passes).
                         if read && inner <= predicted {
                             curvature.measure_spread(points);
                         }
-                        let floors = model.skip_floors(inner, predicted, curvature.spread());
-                        model.error_over_each(curvature, floors)
+                        model.skip_floors(inner, predicted, curvature.spread())
                     } else {
-                        model.error_over(curvature, predicted)
+                        [predicted; 3]
                     };
+                    let error = model.error_deciding(curvature, floors, predicted, |failed| {
+                        deciding.needed(failed)
+                    });
                     if factor == 1 {
                         let finer = model.bound(&error, curvature.spread());
                         let skip = if finer.within(predicted) { key } else { 0 };
@@ -558,6 +561,142 @@ fn pack(key: PatternKey) -> u64 {
     a | b << 8 | c << 16 | u64::from(key.inner) << 24 | u64::from(key.fill) << 32
 }
 
+/// A failing count `c` raised by the square root of its part's error ratio, rounded up: at
+/// least one step, at most `cap`.
+fn scaled(c: u32, error: f64, tolerance: f64, cap: u32) -> u32 {
+    let n = (f64::from(c) * (error / tolerance).sqrt()).ceil() as u32;
+    n.max(c + 1).min(cap)
+}
+
+/// What [`SegmentCounts::raise_until_met`] makes of one failing check of the pattern `key`:
+/// the triangle's new inner level, and the count each edge is raised to at least (0: not
+/// raised). Counts come from the key, the counts of the round the check was made in.
+///
+/// A failing part is raised where the step that fails is (see [`EdgeStep`]); coarse edges go
+/// first: a corner triangle touches both its edges and fails with the coarser, and raising the
+/// finer one too by the same ratio overshoots (50×20 torus at 1e-4: 132,800 triangles with
+/// both raised, 119,500 with the coarse edge first).
+fn raise_of(key: PatternKey, error: &PatternError, tolerance: f64, cap: u32) -> (u32, [u32; 3]) {
+    let (inner_level, finest, steps) = edge_steps(key, error.inner, tolerance, cap);
+    let mut inner = inner_level;
+    let fails = |k: usize| error.edges[k] > tolerance;
+    // While an edge below the inner level fails, the finer ones wait.
+    let coarse_fails = (0..3).any(|k| fails(k) && steps[k] == EdgeStep::Coarse);
+    let mut edges = [0; 3];
+    for k in (0..3).filter(|&k| fails(k)) {
+        let e = key.edges[k];
+        match steps[k] {
+            _ if coarse_fails && steps[k] != EdgeStep::Coarse => {}
+            // An edge below its triangle's inner level is raised to that level at most: the
+            // uniform lattice there meets what the lattice check already passed.
+            EdgeStep::Coarse => {
+                edges[k] = scaled(e, error.edges[k], tolerance, cap).min(inner_level)
+            }
+            // The edge is at least as fine as the inner level: its ring triangles reach one
+            // inner step across it, so that step is what fails. The inner level is raised, to
+            // the finest edge at most (the uniform lattice of that count).
+            EdgeStep::Inner => {
+                inner = inner.max(scaled(inner_level, error.edges[k], tolerance, cap).min(finest));
+            }
+            EdgeStep::Edge => edges[k] = scaled(e, error.edges[k], tolerance, cap),
+        }
+    }
+    (inner, edges)
+}
+
+/// What [`SegmentCounts::raise_until_met`] raises for a failing edge part, from the edge's
+/// count, the triangle's inner level after its own inner part's raise, and its finest edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum EdgeStep {
+    /// The edge is coarser than the inner level: the edge, to that level at most.
+    Coarse,
+    /// The edge is at least as fine as the inner level, which is below the finest edge: the
+    /// inner level, to the finest edge at most.
+    Inner,
+    /// All at one level: the edge, by its error ratio.
+    Edge,
+}
+
+/// The inner level of a check of `key` after its inner part's raise (its error
+/// `inner_error`), the finest edge, and each edge part's [`EdgeStep`].
+fn edge_steps(
+    key: PatternKey,
+    inner_error: f64,
+    tolerance: f64,
+    cap: u32,
+) -> (u32, u32, [EdgeStep; 3]) {
+    let inner_level = if inner_error > tolerance {
+        scaled(key.inner, inner_error, tolerance, cap)
+    } else {
+        key.inner
+    };
+    let finest = key.edges.into_iter().max().unwrap_or(1);
+    let steps = key.edges.map(|edge| {
+        if edge < inner_level {
+            EdgeStep::Coarse
+        } else if inner_level < finest {
+            EdgeStep::Inner
+        } else {
+            EdgeStep::Edge
+        }
+    });
+    (inner_level, finest, steps)
+}
+
+/// Which edge parts of a check can still change what the raise does with its triangle, once
+/// some are known to fail: what lets a check stop reading samples
+/// ([`PatternModel::error_deciding`]) with the same counts after the raise as with every part's
+/// exact value.
+///
+/// A part whose raise is one step at most (a coarse edge one below the inner level, or the
+/// inner level one below the finest edge) raises the same count whatever its error over the
+/// tolerance, since a raise is at least one step; every part of the inner kind then raises the
+/// inner level to the same finest edge, so once one has failed the others change nothing; and
+/// once a coarse edge fails the finer ones are not raised at all. On the 10k icosphere at the
+/// error level 16 reaches, the wave's checks of a triangle whose edge a neighbour raised (edges
+/// `[e + 1, e, e]` around `e`, then around `e + 1`) mostly fail in the first ring read, and stop
+/// there.
+#[derive(Debug, Clone, Copy)]
+struct DecidingParts {
+    steps: [EdgeStep; 3],
+    /// Per part: its raise is the same for any error over the tolerance.
+    settled_by_failing: [bool; 3],
+}
+
+impl DecidingParts {
+    /// For a check of `key` whose inner part's error is `inner_error`, against `tolerance`.
+    fn new(key: PatternKey, inner_error: f64, tolerance: f64, cap: u32) -> DecidingParts {
+        let (inner_level, finest, steps) = edge_steps(key, inner_error, tolerance, cap);
+        let settled_by_failing = [0, 1, 2].map(|k| match steps[k] {
+            EdgeStep::Coarse => key.edges[k] + 1 >= inner_level,
+            EdgeStep::Inner => inner_level + 1 >= finest,
+            EdgeStep::Edge => false,
+        });
+        DecidingParts {
+            steps,
+            settled_by_failing,
+        }
+    }
+
+    /// The parts (bit `k`: edge `k`) whose value can still change the raise once those in
+    /// `failed` are known to be over the tolerance.
+    fn needed(&self, failed: u8) -> u8 {
+        let failing = |k: usize| failed & (1 << k) != 0;
+        let failed_as = |step: EdgeStep| (0..3).any(|k| failing(k) && self.steps[k] == step);
+        let coarse_failed = failed_as(EdgeStep::Coarse);
+        let inner_settled = (0..3)
+            .any(|k| failing(k) && self.steps[k] == EdgeStep::Inner && self.settled_by_failing[k]);
+        (0..3)
+            .filter(|&k| {
+                let decided = failing(k) && self.settled_by_failing[k];
+                let waits = coarse_failed && self.steps[k] != EdgeStep::Coarse;
+                let same_as_failed = inner_settled && self.steps[k] == EdgeStep::Inner;
+                !(decided || waits || same_as_failed)
+            })
+            .fold(0, |mask, k| mask | 1 << k)
+    }
+}
+
 /// The smallest inner level a triangle whose finest edge has `max_edge` segments may have:
 /// `⌈2·max_edge/3⌉`, so no edge has more than 1.5 times the inner level's segments. Over every
 /// pattern this allows with inner levels up to 20 (edges at least half the inner level) the
@@ -654,12 +793,7 @@ impl SegmentCounts {
     /// once per distinct key) and raises the counts of its failing parts until none fails or
     /// they are at `cap`; after the first round only triangles whose counts changed are checked.
     ///
-    /// A failing edge part is raised where the step that fails is: an edge coarser than the
-    /// inner level, up to that level; else the inner level, whose step is how far the ring
-    /// triangles reach across the edge, up to the finest edge; else (all at one level) the
-    /// edge. Coarse edges go first: a corner triangle touches both its edges and fails with
-    /// the coarser, and raising the finer one too by the same ratio overshoots (50×20 torus
-    /// at 1e-4: 132,800 triangles with both raised, 119,500 with the coarse edge first).
+    /// A failing check raises what [`raise_of`] says.
     ///
     /// `check` gets a per-thread scratch `S`, what the triangle's previous check kept (empty if
     /// none), and a buffer to append what its next check could reuse; that is held until the
@@ -714,62 +848,21 @@ impl SegmentCounts {
                 }
                 kept[t] = keep;
             }
-            for (c, k) in checked.iter_mut().zip(keys) {
-                *c = Some(k);
-            }
             // Each failing part scales its count from this round's counts; an edge between two
             // failing triangles takes the larger, not both in turn.
             let mut raised = false;
-            let edges_before = self.edges.clone();
-            let scale = |c: u32, error: f64| {
-                let n = (f64::from(c) * (error / tolerance).sqrt()).ceil() as u32;
-                n.max(c + 1).min(cap)
-            };
             for (t, error) in over {
-                if error.inner > tolerance {
-                    let inner = scale(self.inner[t], error.inner);
-                    raised |= inner > self.inner[t];
-                    self.inner[t] = inner;
+                let (inner, edges) = raise_of(keys[t], &error, tolerance, cap);
+                raised |= inner > self.inner[t];
+                self.inner[t] = inner;
+                for (e, next) in topo.tri_edges[t].into_iter().zip(edges) {
+                    let count = &mut self.edges[e.0 as usize];
+                    raised |= next > *count;
+                    *count = (*count).max(next);
                 }
-                let inner_level = self.inner[t];
-                let finest = topo.tri_edges[t]
-                    .iter()
-                    .map(|e| edges_before[e.0 as usize])
-                    .max()
-                    .unwrap_or(1);
-                // A triangle at a corner touches both its edges and fails with the coarser:
-                // while an edge below the inner level fails, the finer ones wait.
-                let coarse_fails = topo.tri_edges[t].iter().enumerate().any(|(k, e)| {
-                    error.edges[k] > tolerance && edges_before[e.0 as usize] < inner_level
-                });
-                for (k, e) in topo.tri_edges[t].into_iter().enumerate() {
-                    if error.edges[k] > tolerance {
-                        let e = e.0 as usize;
-                        if coarse_fails && edges_before[e] >= inner_level {
-                            continue;
-                        }
-                        if edges_before[e] < inner_level {
-                            // An edge below its triangle's inner level is raised to that
-                            // level at most: the uniform lattice there meets what the lattice
-                            // check already passed.
-                            let next = scale(edges_before[e], error.edges[k]).min(inner_level);
-                            raised |= next > self.edges[e];
-                            self.edges[e] = self.edges[e].max(next);
-                        } else if inner_level < finest {
-                            // The edge is at least as fine as the inner level: its ring
-                            // triangles reach one inner step across it, so that step is what
-                            // fails. The inner level is raised, to the finest edge at most
-                            // (the uniform lattice of that count).
-                            let next = scale(inner_level, error.edges[k]).min(finest);
-                            raised |= next > self.inner[t];
-                            self.inner[t] = self.inner[t].max(next);
-                        } else {
-                            let next = scale(edges_before[e], error.edges[k]);
-                            raised |= next > self.edges[e];
-                            self.edges[e] = self.edges[e].max(next);
-                        }
-                    }
-                }
+            }
+            for (c, k) in checked.iter_mut().zip(keys) {
+                *c = Some(k);
             }
             if !raised {
                 return;
@@ -809,5 +902,109 @@ impl SegmentCounts {
                 break;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What an early stop of [`PatternModel::error_deciding`] may leave of `exact` when the
+    /// parts are read in `order`, each `needed` one until it is known to fail: a failed part
+    /// just over the tolerance, a part never read anything up to its value (here `fraction` of
+    /// it, at most the tolerance, as an unread part is never known to fail), and a part read to
+    /// its end its exact value.
+    fn stopped_early(
+        deciding: &DecidingParts,
+        exact: &PatternError,
+        tolerance: f64,
+        order: [usize; 3],
+        fraction: f64,
+    ) -> (PatternError, bool) {
+        let mut partial = PatternError {
+            inner: exact.inner,
+            edges: exact.edges.map(|e| fraction * e.min(tolerance)),
+        };
+        let (mut failed, mut skipped) = (0u8, false);
+        for k in order {
+            if deciding.needed(failed) & (1 << k) == 0 {
+                skipped = true;
+                continue;
+            }
+            partial.edges[k] = exact.edges[k];
+            if exact.edges[k] > tolerance {
+                failed |= 1 << k;
+                // Read until known to fail, and on only while still needed.
+                if deciding.needed(failed) & (1 << k) == 0 {
+                    partial.edges[k] = exact.edges[k].min(tolerance * (1.0 + 1e-9));
+                }
+            }
+        }
+        (partial, skipped)
+    }
+
+    /// A check that stops once [`DecidingParts`] says nothing left can change the raise leaves
+    /// the raise as every part's exact value does: over keys the balance allows, errors on
+    /// both sides of the tolerance and at several distances over it (so that valued raises,
+    /// one step and several steps, all occur), every order the parts can be read in, and
+    /// unread parts at any value up to their own.
+    #[test]
+    fn stopping_where_nothing_is_left_to_decide_leaves_the_raise_as_it_is() {
+        let tolerance = 1e-4;
+        let ratios = [0.3, 1.0, 1.001, 1.3, 2.0, 5.0];
+        let orders = [
+            [0, 1, 2],
+            [0, 2, 1],
+            [1, 0, 2],
+            [1, 2, 0],
+            [2, 0, 1],
+            [2, 1, 0],
+        ];
+        let (mut checks, mut stopped) = (0usize, 0usize);
+        for cap in [9, 255] {
+            for inner in 1..=8u32 {
+                for edges in (0..512u32).map(|i| [i & 7, (i >> 3) & 7, i >> 6].map(|c| c + 1)) {
+                    let finest = edges.into_iter().max().unwrap_or(1);
+                    if inner < inner_floor(finest) || edges.iter().any(|&e| 2 * e < inner) {
+                        continue;
+                    }
+                    let key = PatternKey {
+                        edges,
+                        inner,
+                        fill: 0,
+                    };
+                    for inner_ratio in [0.5, 1.7] {
+                        for i in 0..ratios.len().pow(3) {
+                            let n = ratios.len();
+                            let r = [i % n, (i / n) % n, i / (n * n)].map(|j| ratios[j]);
+                            let exact = PatternError {
+                                inner: inner_ratio * tolerance,
+                                edges: r.map(|x| x * tolerance),
+                            };
+                            let deciding = DecidingParts::new(key, exact.inner, tolerance, cap);
+                            let expected = raise_of(key, &exact, tolerance, cap);
+                            for order in orders {
+                                for fraction in [0.0, 1.0] {
+                                    let (partial, skipped) = stopped_early(
+                                        &deciding, &exact, tolerance, order, fraction,
+                                    );
+                                    assert_eq!(
+                                        raise_of(key, &partial, tolerance, cap),
+                                        expected,
+                                        "{key:?} cap {cap}: {exact:?} read as {partial:?}"
+                                    );
+                                    checks += 1;
+                                    stopped += usize::from(skipped);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            stopped > checks / 10,
+            "{stopped} of {checks} reads stopped early"
+        );
     }
 }

@@ -395,10 +395,10 @@ pub(crate) struct PatternModel {
     level: u32,
     /// Ordered by the edges they touch (bit mask), those touching one edge first.
     boundary: Vec<ModelSample>,
-    /// The runs of [`PatternModel::boundary`] with the same edges touched: the mask and the
-    /// end of its run. A run touching one edge keeps that edge's maximum in a register and
+    /// The runs of [`PatternModel::boundary`] with the same edges touched: the mask, the start
+    /// and the end of its run. A run touching one edge keeps that edge's maximum in a register and
     /// needs no per-sample test of the mask, which was about half of what a check cost.
-    runs: Vec<(u8, u32)>,
+    runs: Vec<(u8, u32, u32)>,
     /// Per edge, how much the predicted error of its triangles can grow per unit of
     /// [`Curvature::spread`]: each second difference `δ_k` off by at most `s` moves
     /// `Q_e = L²(ii δ₁ + jj δ₂ + ij (δ₁ + δ₂ − δ₃))` by at most
@@ -476,11 +476,12 @@ impl PatternModel {
         // `PatternModel::error`): single edges first, so that the floors of the samples
         // touching two edges are already those edges' largest single-edge errors.
         boundary.sort_by_key(|s| (s.touches.count_ones(), s.touches));
-        let mut runs: Vec<(u8, u32)> = Vec::new();
+        let mut runs: Vec<(u8, u32, u32)> = Vec::new();
         for (i, s) in boundary.iter().enumerate() {
+            let i = i as u32;
             match runs.last_mut() {
-                Some((mask, end)) if *mask == s.touches => *end = i as u32 + 1,
-                _ => runs.push((s.touches, i as u32 + 1)),
+                Some((mask, _, end)) if *mask == s.touches => *end = i + 1,
+                _ => runs.push((s.touches, i, i + 1)),
             }
         }
         PatternModel {
@@ -557,12 +558,35 @@ impl PatternModel {
     /// passing parts with `floor` and scales failing ones by their value decides the same with
     /// either. A sample whose bound is at or below `floor` is not summed: it cannot raise a part
     /// above `floor`, as one under the part's maximum so far cannot raise that maximum.
+    #[cfg(test)]
     pub fn error_over(&self, curvature: &mut Curvature, floor: f64) -> PatternError {
         self.error_over_each(curvature, [floor; 3])
     }
 
     /// [`PatternModel::error_over`] with a floor per edge part, `floors[k]` for edge `k`'s.
+    #[cfg(test)]
     pub fn error_over_each(&self, curvature: &mut Curvature, floors: [f64; 3]) -> PatternError {
+        self.error_deciding(curvature, floors, f64::INFINITY, |_| ALL_EDGES)
+    }
+
+    /// [`PatternModel::error_over_each`] for a check whose caller only needs what decides its
+    /// outcome: once the edge parts in `failed` are known to be over `tolerance`,
+    /// `needed(failed)` names the parts whose value can still change it (bit `k`: edge `k`),
+    /// and the samples of the others are not read. A part over `tolerance` is returned over
+    /// it, at most its exact value; a part no longer needed at most its exact value; every
+    /// other part as [`PatternModel::error_over_each`] gives it. With `needed` always all
+    /// three parts, the two are the same.
+    ///
+    /// The runs touching one edge whose count differs from the inner level are read first:
+    /// those are the transition rings, where a check that fails mostly fails, so that what
+    /// decides it is known early.
+    pub fn error_deciding(
+        &self,
+        curvature: &mut Curvature,
+        floors: [f64; 3],
+        tolerance: f64,
+        needed: impl Fn(u8) -> u8,
+    ) -> PatternError {
         let mut out = PatternError {
             inner: curvature.inner_error(self.key.inner),
             edges: [0.0; 3],
@@ -576,18 +600,37 @@ impl PatternModel {
         // the floor, the smallest maximum it could raise: so reading the samples run by run
         // gives the plain maximum bit for bit.
         let l2 = f64::from(self.level).powi(2);
-        let mut start = 0;
-        for &(mask, end) in &self.runs {
-            let run = &self.boundary[start..end as usize];
-            start = end as usize;
+        let (mut failed, mut wanted) = (0u8, needed(0));
+        let ring_first = |run: usize| {
+            let (mask, _, _) = self.runs[run];
+            mask.count_ones() == 1
+                && self.key.edges[mask.trailing_zeros() as usize] != self.key.inner
+        };
+        let order = (0..self.runs.len())
+            .filter(|&r| ring_first(r))
+            .chain((0..self.runs.len()).filter(|&r| !ring_first(r)));
+        for r in order {
+            if wanted == 0 {
+                break;
+            }
+            let (mask, start, end) = self.runs[r];
+            if mask & wanted == 0 {
+                continue;
+            }
+            let run = &self.boundary[start as usize..end as usize];
             if mask.count_ones() == 1 {
                 let k = mask.trailing_zeros() as usize;
                 let mut worst = out.edges[k];
                 for t in run {
-                    worst = larger(
-                        worst,
-                        curvature.sample_error(t, larger(worst, floors[k]), l2),
-                    );
+                    let e = curvature.sample_error(t, larger(worst, floors[k]), l2);
+                    worst = larger(worst, e);
+                    if e > tolerance && failed & mask == 0 {
+                        failed |= mask;
+                        wanted = needed(failed);
+                        if wanted & mask == 0 {
+                            break;
+                        }
+                    }
                 }
                 out.edges[k] = worst;
                 continue;
@@ -609,11 +652,22 @@ impl PatternModel {
                         *edge = larger(*edge, e);
                     }
                 }
+                if e > tolerance && failed & mask != mask {
+                    failed |= mask;
+                    wanted = needed(failed);
+                    if wanted & mask == 0 {
+                        break;
+                    }
+                }
             }
         }
         out
     }
 }
+
+/// Every edge part of a pattern (bit `k`: edge `k`).
+#[cfg(test)]
+const ALL_EDGES: u8 = 0b111;
 
 #[cfg(test)]
 mod tests {
@@ -857,6 +911,72 @@ mod tests {
             }
         }
         assert!(above > 100 && below > 100, "{above} above, {below} below");
+    }
+
+    /// [`PatternModel::error_deciding`] keeps its contract whatever parts its caller still
+    /// needs: a part known to fail comes back over the tolerance, every part at most its exact
+    /// value, and a part needed to the end (always, or until it fails and never failing) with
+    /// the bits of [`PatternModel::error_over_each`]; and a caller needing nothing once a part
+    /// fails gets whether the check passes right.
+    #[test]
+    fn the_deciding_error_keeps_what_its_caller_needs() {
+        let (mut failing, mut passing) = (0, 0);
+        for f in smooth_fields() {
+            for key in keys() {
+                let pattern = Pattern::new(key);
+                for level in [6, key.inner, 2 * key.inner] {
+                    let model = PatternModel::new(&pattern, level);
+                    let points = height_lattice(level, 1.0, &f);
+                    let exact = model.error_over_each(&mut curvature(&points, level), [0.0; 3]);
+                    for scale in [0.5, 0.9, 1.0, 1.1, 2.0] {
+                        let tolerance = scale * exact.edges.iter().fold(0.0, |a, &b| b.max(a));
+                        let floors = [tolerance; 3];
+                        let over = model.error_over_each(&mut curvature(&points, level), floors);
+                        let until_failing = model.error_deciding(
+                            &mut curvature(&points, level),
+                            floors,
+                            tolerance,
+                            |failed| ALL_EDGES & !failed,
+                        );
+                        let until_first = model.error_deciding(
+                            &mut curvature(&points, level),
+                            floors,
+                            tolerance,
+                            |failed| if failed == 0 { ALL_EDGES } else { 0 },
+                        );
+                        for k in 0..3 {
+                            assert!(until_first.edges[k] <= exact.edges[k], "{key:?} at {level}");
+                            if exact.edges[k] > tolerance {
+                                failing += 1;
+                                assert!(until_failing.edges[k] > tolerance, "{key:?} at {level}");
+                                assert!(until_failing.edges[k] <= exact.edges[k]);
+                            } else {
+                                passing += 1;
+                                assert_eq!(
+                                    until_failing.edges[k].to_bits(),
+                                    over.edges[k].to_bits(),
+                                    "{key:?} at {level}"
+                                );
+                            }
+                        }
+                        assert_eq!(
+                            until_first.within(tolerance),
+                            exact.within(tolerance),
+                            "{key:?} at {level}, tolerance {tolerance}"
+                        );
+                        if exact.within(tolerance) {
+                            for k in 0..3 {
+                                assert_eq!(until_first.edges[k].to_bits(), over.edges[k].to_bits());
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            failing > 50 && passing > 50,
+            "{failing} failing, {passing} passing"
+        );
     }
 
     /// Stage 1's check decides the same with [`PatternModel::skip_floors`] as with every part
