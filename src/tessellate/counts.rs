@@ -156,14 +156,15 @@ impl ChordErrors {
                         .iter()
                         .map(|s| s.position.abs().max_element())
                         .fold(0.0, f64::max);
+                    // Kept with the lattice: stage 0 scales it for each inner level.
+                    let inner = curvature.inner_error(p);
                     let mut kept = Vec::new();
                     if keep {
                         curvature.keep(&mut kept);
                         debug_assert_eq!(kept.len(), PROBE_STRIDE);
                     }
                     (
-                        // Kept with the lattice: stage 0 scales it for each inner level.
-                        finite(curvature.inner_error(p) * scale),
+                        finite(inner * scale),
                         edges.map(|d| finite(d * scale / 8.0)),
                         largest,
                         kept,
@@ -339,10 +340,10 @@ impl ChordErrors {
                     let level = check_level(model.inner(), factor);
                     // The lattice depends on the triangle and the level alone: a triangle checked
                     // again with only its edge counts raised reads the second differences it kept.
-                    // Stage 0 reads, at its first check, the probe's own lattice.
-                    let restored = curvature.restore(level, kept)
-                        || (factor == 0 && curvature.restore(level, self.probed_at(tri)));
-                    let read = !restored;
+                    // Stage 0 reads the probe's own lattice as the probe kept it, at every check,
+                    // and so keeps nothing of its own.
+                    let from_probe = factor == 0 && curvature.restore(level, self.probed_at(tri));
+                    let read = !(from_probe || curvature.restore(level, kept));
                     if read {
                         points.clear();
                         // Second differences are taken along interior points' normals only.
@@ -395,7 +396,7 @@ impl ChordErrors {
                     // differences only where the lattice is at most twice the pattern's level
                     // (not a flat part's probe-level lattice), so what is held stays within a
                     // few times the output's own interior points.
-                    if !error.within(predicted) || level <= 2 * model.inner() {
+                    if !from_probe && (!error.within(predicted) || level <= 2 * model.inner()) {
                         curvature.keep(keep);
                     }
                     error

@@ -463,8 +463,14 @@ impl PatternModel {
                 });
             }
         }
+        // Samples that differ only in the edges they touch merge into one whatever their order,
+        // so the sort need not be stable; the point, compared first, mostly decides it.
         let same_key = |s: &ModelSample| (s.point, s.edges.map(|e| e.map(f64::to_bits)));
-        boundary.sort_by_key(same_key);
+        boundary.sort_unstable_by(|a, b| {
+            a.point
+                .cmp(&b.point)
+                .then_with(|| same_key(a).cmp(&same_key(b)))
+        });
         boundary.dedup_by(|later, kept| {
             let same = same_key(later) == same_key(kept);
             if same {
