@@ -953,14 +953,10 @@ mod tests {
     fn stopping_where_nothing_is_left_to_decide_leaves_the_raise_as_it_is() {
         let tolerance = 1e-4;
         let ratios = [0.3, 1.0, 1.001, 1.3, 2.0, 5.0];
-        let orders = [
-            [0, 1, 2],
-            [0, 2, 1],
-            [1, 0, 2],
-            [1, 2, 0],
-            [2, 0, 1],
-            [2, 1, 0],
-        ];
+        let orders: Vec<[usize; 3]> = (0..27)
+            .map(|i| [i % 3, (i / 3) % 3, i / 9])
+            .filter(|[a, b, c]| a != b && b != c && a != c)
+            .collect();
         let (mut checks, mut stopped) = (0usize, 0usize);
         for cap in [9, 255] {
             for inner in 1..=8u32 {
@@ -984,7 +980,7 @@ mod tests {
                             };
                             let deciding = DecidingParts::new(key, exact.inner, tolerance, cap);
                             let expected = raise_of(key, &exact, tolerance, cap);
-                            for order in orders {
+                            for &order in &orders {
                                 for fraction in [0.0, 1.0] {
                                     let (partial, skipped) = stopped_early(
                                         &deciding, &exact, tolerance, order, fraction,

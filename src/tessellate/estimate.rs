@@ -755,6 +755,23 @@ mod tests {
         .to_vec()
     }
 
+    /// Calls `visit` with every smooth field's lattice at each of `levels(key)` and the model
+    /// of every test key's pattern over it.
+    fn each_model(
+        levels: impl Fn(PatternKey) -> Vec<u32>,
+        mut visit: impl FnMut(PatternKey, u32, &PatternModel, &[SurfacePoint]),
+    ) {
+        for f in smooth_fields() {
+            for key in keys() {
+                let pattern = Pattern::new(key);
+                for level in levels(key) {
+                    let model = PatternModel::new(&pattern, level);
+                    visit(key, level, &model, &height_lattice(level, 1.0, &f));
+                }
+            }
+        }
+    }
+
     /// What the stage-2 skip rests on: the errors a model predicts from the lattice at twice
     /// the resolution are at most [`PatternModel::bound`] of those predicted from the pattern's
     /// own lattice with its spread, on smooth surfaces; and without the spread they are not
@@ -884,38 +901,34 @@ mod tests {
     #[test]
     fn the_error_over_a_floor_is_exact_above_it() {
         let (mut above, mut below) = (0, 0);
-        for f in smooth_fields() {
-            for key in keys() {
-                let pattern = Pattern::new(key);
-                for level in [6, key.inner, 2 * key.inner] {
-                    let model = PatternModel::new(&pattern, level);
-                    let points = height_lattice(level, 1.0, &f);
-                    let exact = model.error(&mut curvature(&points, level));
-                    let parts = exact.edges;
-                    let mut floors: Vec<f64> = parts.to_vec();
-                    for p in parts {
-                        floors.extend([0.5 * p, 0.99 * p, 1.01 * p, 2.0 * p]);
-                    }
-                    for floor in floors {
-                        let over = model.error_over(&mut curvature(&points, level), floor);
-                        assert_eq!(over.inner.to_bits(), exact.inner.to_bits());
-                        for k in 0..3 {
-                            if exact.edges[k] > floor {
-                                above += 1;
-                                assert_eq!(
-                                    over.edges[k].to_bits(),
-                                    exact.edges[k].to_bits(),
-                                    "{key:?} at {level}, floor {floor}"
-                                );
-                            } else {
-                                below += 1;
-                                assert!(over.edges[k] <= floor, "{key:?} at {level}");
-                            }
+        each_model(
+            |key| vec![6, key.inner, 2 * key.inner],
+            |key, level, model, points| {
+                let exact = model.error(&mut curvature(points, level));
+                let parts = exact.edges;
+                let mut floors: Vec<f64> = parts.to_vec();
+                for p in parts {
+                    floors.extend([0.5 * p, 0.99 * p, 1.01 * p, 2.0 * p]);
+                }
+                for floor in floors {
+                    let over = model.error_over(&mut curvature(points, level), floor);
+                    assert_eq!(over.inner.to_bits(), exact.inner.to_bits());
+                    for k in 0..3 {
+                        if exact.edges[k] > floor {
+                            above += 1;
+                            assert_eq!(
+                                over.edges[k].to_bits(),
+                                exact.edges[k].to_bits(),
+                                "{key:?} at {level}, floor {floor}"
+                            );
+                        } else {
+                            below += 1;
+                            assert!(over.edges[k] <= floor, "{key:?} at {level}");
                         }
                     }
                 }
-            }
-        }
+            },
+        );
         assert!(above > 100 && below > 100, "{above} above, {below} below");
     }
 
@@ -927,58 +940,54 @@ mod tests {
     #[test]
     fn the_deciding_error_keeps_what_its_caller_needs() {
         let (mut failing, mut passing) = (0, 0);
-        for f in smooth_fields() {
-            for key in keys() {
-                let pattern = Pattern::new(key);
-                for level in [6, key.inner, 2 * key.inner] {
-                    let model = PatternModel::new(&pattern, level);
-                    let points = height_lattice(level, 1.0, &f);
-                    let exact = model.error_over_each(&mut curvature(&points, level), [0.0; 3]);
-                    for scale in [0.5, 0.9, 1.0, 1.1, 2.0] {
-                        let tolerance = scale * exact.edges.iter().fold(0.0, |a, &b| b.max(a));
-                        let floors = [tolerance; 3];
-                        let over = model.error_over_each(&mut curvature(&points, level), floors);
-                        let until_failing = model.error_deciding(
-                            &mut curvature(&points, level),
-                            floors,
-                            tolerance,
-                            |failed| ALL_EDGES & !failed,
-                        );
-                        let until_first = model.error_deciding(
-                            &mut curvature(&points, level),
-                            floors,
-                            tolerance,
-                            |failed| if failed == 0 { ALL_EDGES } else { 0 },
-                        );
-                        for k in 0..3 {
-                            assert!(until_first.edges[k] <= exact.edges[k], "{key:?} at {level}");
-                            if exact.edges[k] > tolerance {
-                                failing += 1;
-                                assert!(until_failing.edges[k] > tolerance, "{key:?} at {level}");
-                                assert!(until_failing.edges[k] <= exact.edges[k]);
-                            } else {
-                                passing += 1;
-                                assert_eq!(
-                                    until_failing.edges[k].to_bits(),
-                                    over.edges[k].to_bits(),
-                                    "{key:?} at {level}"
-                                );
-                            }
+        each_model(
+            |key| vec![6, key.inner, 2 * key.inner],
+            |key, level, model, points| {
+                let exact = model.error_over_each(&mut curvature(points, level), [0.0; 3]);
+                for scale in [0.5, 0.9, 1.0, 1.1, 2.0] {
+                    let tolerance = scale * exact.edges.iter().fold(0.0, |a, &b| b.max(a));
+                    let floors = [tolerance; 3];
+                    let over = model.error_over_each(&mut curvature(points, level), floors);
+                    let until_failing = model.error_deciding(
+                        &mut curvature(points, level),
+                        floors,
+                        tolerance,
+                        |failed| ALL_EDGES & !failed,
+                    );
+                    let until_first = model.error_deciding(
+                        &mut curvature(points, level),
+                        floors,
+                        tolerance,
+                        |failed| if failed == 0 { ALL_EDGES } else { 0 },
+                    );
+                    for k in 0..3 {
+                        assert!(until_first.edges[k] <= exact.edges[k], "{key:?} at {level}");
+                        if exact.edges[k] > tolerance {
+                            failing += 1;
+                            assert!(until_failing.edges[k] > tolerance, "{key:?} at {level}");
+                            assert!(until_failing.edges[k] <= exact.edges[k]);
+                        } else {
+                            passing += 1;
+                            assert_eq!(
+                                until_failing.edges[k].to_bits(),
+                                over.edges[k].to_bits(),
+                                "{key:?} at {level}"
+                            );
                         }
-                        assert_eq!(
-                            until_first.within(tolerance),
-                            exact.within(tolerance),
-                            "{key:?} at {level}, tolerance {tolerance}"
-                        );
-                        if exact.within(tolerance) {
-                            for k in 0..3 {
-                                assert_eq!(until_first.edges[k].to_bits(), over.edges[k].to_bits());
-                            }
+                    }
+                    assert_eq!(
+                        until_first.within(tolerance),
+                        exact.within(tolerance),
+                        "{key:?} at {level}, tolerance {tolerance}"
+                    );
+                    if exact.within(tolerance) {
+                        for k in 0..3 {
+                            assert_eq!(until_first.edges[k].to_bits(), over.edges[k].to_bits());
                         }
                     }
                 }
-            }
-        }
+            },
+        );
         assert!(
             failing > 50 && passing > 50,
             "{failing} failing, {passing} passing"
