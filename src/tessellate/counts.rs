@@ -321,7 +321,7 @@ impl ChordErrors {
         let resolved: Vec<AtomicU64> = (0..counts.inner.len()).map(|_| AtomicU64::new(0)).collect();
         // Per triangle, the last lattice stage 1 read while it did not resolve: stage 2 checks
         // it on the lattice of twice that level, whose even points these are (`Coarse`).
-        let coarse = Coarse::new(counts.inner.len());
+        let coarse = Coarse::new();
         for factor in [0, 1, 2] {
             counts.raise_until_met(
                 topo,
@@ -472,15 +472,24 @@ impl ChordErrors {
 /// quarter of its points (on the 10k icosphere at the error level 16 reaches, 212,000 of
 /// stage 2's 847,020). Only the last check of each triangle decides: a triangle stage 1
 /// resolves frees what it kept, so what is held is the lattices of the triangles stage 2 will
-/// check (1,420 there, about 11 MB), and none once stage 2 has read them.
-struct Coarse(Vec<Mutex<Option<KeptLattice>>>);
+/// check (1,420 there, about 11 MB), and none once stage 2 has read them. A table by triangle
+/// rather than a slot per triangle, so that a mesh whose triangles nearly all resolve in stage
+/// 1 pays for the few it keeps (a slot per triangle was 40 bytes each: 40 MB at 1M).
+struct Coarse(Mutex<KeptLattices>);
+
+/// [`Coarse`]'s lattices by triangle.
+type KeptLattices = HashMap<u32, KeptLattice, BuildHasherDefault<KeyHasher>>;
 
 /// A whole lattice as a check read it, and its level.
 type KeptLattice = (u32, Vec<SurfacePoint>);
 
 impl Coarse {
-    fn new(triangles: usize) -> Coarse {
-        Coarse((0..triangles).map(|_| Mutex::new(None)).collect())
+    fn new() -> Coarse {
+        Coarse(Mutex::new(HashMap::default()))
+    }
+
+    fn lattices(&self) -> std::sync::MutexGuard<'_, KeptLattices> {
+        self.0.lock().expect("no check panics while keeping")
     }
 
     /// After a stage-1 check of `tri`: `Some((level, read, points))` when stage 2 will check
@@ -488,22 +497,23 @@ impl Coarse {
     /// (else the one kept, if of that level, stays); `None` when stage 2 will not check it at
     /// twice this level, which frees what was kept.
     fn note(&self, tri: usize, kept: Option<(u32, bool, &[SurfacePoint])>) {
-        let mut slot = self.0[tri].lock().expect("no check panics while keeping");
+        let tri = tri as u32;
+        let mut lattices = self.lattices();
         match kept {
-            Some((level, true, points)) => match slot.as_mut() {
-                Some((l, held)) => {
-                    *l = level;
-                    held.clear();
-                    held.extend_from_slice(points);
-                }
-                None => *slot = Some((level, points.to_vec())),
-            },
+            Some((level, true, points)) => {
+                let (l, held) = lattices.entry(tri).or_default();
+                *l = level;
+                held.clear();
+                held.extend_from_slice(points);
+            }
             Some((level, false, _)) => {
-                if slot.as_ref().is_some_and(|(l, _)| *l != level) {
-                    *slot = None;
+                if lattices.get(&tri).is_some_and(|(l, _)| *l != level) {
+                    lattices.remove(&tri);
                 }
             }
-            None => *slot = None,
+            None => {
+                lattices.remove(&tri);
+            }
         }
     }
 
@@ -514,10 +524,7 @@ impl Coarse {
         if factor != 2 {
             return None;
         }
-        let kept = self.0[tri]
-            .lock()
-            .expect("no check panics while keeping")
-            .take();
+        let kept = self.lattices().remove(&(tri as u32));
         kept.filter(|(l, _)| 2 * l == level)
             .map(|(_, points)| points)
     }
@@ -526,9 +533,9 @@ impl Coarse {
 /// The hash of [`SegmentCounts::raise_until_met`]'s table of built keys, looked up twice per
 /// check (a key that changed, then the check's own): a multiply-rotate over the key's bytes
 /// instead of the default SipHash, which was about 200 instructions a lookup (41M of the 10k
-/// icosphere's run at the error level 16 reaches). The keys are counts, not input an attacker
-/// picks, and the table is only looked up, never walked, so nothing depends on the hash's
-/// values.
+/// icosphere's run at the error level 16 reaches); also [`Coarse`]'s, by triangle index. The
+/// keys are counts and indices, not input an attacker picks, and the tables are only looked
+/// up, never walked, so nothing depends on the hash's values.
 #[derive(Debug, Default)]
 struct KeyHasher(u64);
 
