@@ -397,7 +397,11 @@ pub(crate) struct PatternModel {
     boundary: Vec<ModelSample>,
     /// The runs of [`PatternModel::boundary`] with the same edges touched: the mask, the start
     /// and the end of its run. A run touching one edge keeps that edge's maximum in a register and
-    /// needs no per-sample test of the mask, which was about half of what a check cost.
+    /// needs no per-sample test of the mask, which was about half of what a check cost. In the
+    /// order [`PatternModel::error_deciding`] reads them: the runs touching one edge whose count
+    /// differs from the inner level first (the transition rings, where a check that fails mostly
+    /// fails, so that what decides it is known early), then the other single-edge runs, then
+    /// those touching two edges.
     runs: Vec<(u8, u32, u32)>,
     /// Per edge, how much the predicted error of its triangles can grow per unit of
     /// [`Curvature::spread`]: each second difference `δ_k` off by at most `s` moves
@@ -490,6 +494,12 @@ impl PatternModel {
                 _ => runs.push((s.touches, i, i + 1)),
             }
         }
+        let ring = |mask: u8| {
+            mask.count_ones() == 1
+                && pattern.key.edges[mask.trailing_zeros() as usize] != pattern.key.inner
+        };
+        // Stable: the other runs keep their order, single edges before pairs.
+        runs.sort_by_key(|&(mask, _, _)| !ring(mask));
         PatternModel {
             key: pattern.key,
             level,
@@ -583,9 +593,8 @@ impl PatternModel {
     /// other part as [`PatternModel::error_over_each`] gives it. With `needed` always all
     /// three parts, the two are the same.
     ///
-    /// The runs touching one edge whose count differs from the inner level are read first:
-    /// those are the transition rings, where a check that fails mostly fails, so that what
-    /// decides it is known early.
+    /// The runs are read in the order [`PatternModel::runs`] keeps them, the transition rings
+    /// first, so that what decides a failing check is known early.
     pub fn error_deciding(
         &self,
         curvature: &mut Curvature,
@@ -607,19 +616,10 @@ impl PatternModel {
         // gives the plain maximum bit for bit.
         let l2 = f64::from(self.level).powi(2);
         let (mut failed, mut wanted) = (0u8, needed(0));
-        let ring_first = |run: usize| {
-            let (mask, _, _) = self.runs[run];
-            mask.count_ones() == 1
-                && self.key.edges[mask.trailing_zeros() as usize] != self.key.inner
-        };
-        let order = (0..self.runs.len())
-            .filter(|&r| ring_first(r))
-            .chain((0..self.runs.len()).filter(|&r| !ring_first(r)));
-        for r in order {
+        for &(mask, start, end) in &self.runs {
             if wanted == 0 {
                 break;
             }
-            let (mask, start, end) = self.runs[r];
             if mask & wanted == 0 {
                 continue;
             }
