@@ -220,12 +220,11 @@ fn a_sidecar_level_past_64_is_refused() {
 }
 
 /// One SIGTERM stops the file in flight between its stages: exit status 130 and no output,
-/// where it used to finish the file (6.4 million output triangles here) first.
+/// where it used to finish the file (14.4 million output triangles here) first.
 #[test]
 fn sigterm_stops_the_file_in_flight() {
     let dir = corpus::temp_dir();
-    // A fan of 100 000 triangles at level 12 (14.4 M output triangles): two to three seconds
-    // of work, so the signal at 0.7 s lands while the file is in flight.
+    // A fan of 100 000 triangles at level 12 (14.4 M output triangles).
     let n = 100_000u32;
     let turn = |i: u32| std::f32::consts::TAU * i as f32 / n as f32;
     let mut p = vec![[0.0f32, 0.0, 0.0]];
@@ -234,18 +233,28 @@ fn sigterm_stops_the_file_in_flight() {
     let idx: Vec<u32> = (0..n).flat_map(|i| [0, i + 1, (i + 1) % n + 1]).collect();
     let input = hostile::write_mesh(dir.path(), &p, Some(&normals), &idx);
     let output = dir.path().join("out.glb");
+    let args = [
+        input.as_os_str(),
+        "-o".as_ref(),
+        output.as_os_str(),
+        "--level".as_ref(),
+        "12".as_ref(),
+    ];
+    // The signal must land while the file is in flight, before the poll ahead of its write,
+    // whatever this machine's and this build's speed: a whole run is timed first, and the
+    // signal sent at a fifth of it, inside the tessellation (a fixed 0.7 s was after the end
+    // of a 0.55 s optimized run on a fast machine).
+    let clock = std::time::Instant::now();
+    let whole = corpus::g2tess().args(args).output().unwrap();
+    assert_eq!(whole.status.code(), Some(0), "{whole:?}");
+    let fifth = clock.elapsed() / 5;
+    std::fs::remove_file(&output).unwrap();
     let child = corpus::g2tess()
-        .args([
-            input.as_os_str(),
-            "-o".as_ref(),
-            output.as_os_str(),
-            "--level".as_ref(),
-            "12".as_ref(),
-        ])
+        .args(args)
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(700));
+    std::thread::sleep(fifth);
     let killed = std::process::Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
         .status()
