@@ -43,7 +43,7 @@ pub(crate) struct Curvature {
     /// The inner lattice error last computed on this lattice and the inner level it was for
     /// ([`Curvature::inner_error`]); level 0: none; level [`EVERY_POINT`]: the largest error
     /// over every interior point, unscaled, which gives the error of every inner level at or
-    /// above the lattice's.
+    /// above the lattice's (what [`Curvature::read`] leaves).
     inner: (u32, f64),
 }
 
@@ -126,30 +126,46 @@ impl Curvature {
 
     /// Reads the second differences of `points`, the whole level-`level` lattice (`level ≥ 3`)
     /// in lattice order; reuses its own storage.
+    ///
+    /// The largest error of the inner lattice over every interior point, which
+    /// [`Curvature::inner_error`] gives any inner level at or above this one from (the checks
+    /// at a pattern's own resolution and the probe ask for it after every read), is taken in the
+    /// same pass, while each point's differences are in registers: the same filter and maximum
+    /// as [`Curvature::lattice_error`] at the lattice's own level, in the same order, so the same
+    /// bits. The rows are walked as windows of the rows below, at and above, written into the
+    /// storage sized once, so the loop has no bounds checks or growth of its own.
     pub fn read(&mut self, points: &[SurfacePoint], level: u32) {
         debug_assert!(level >= 3);
         self.level = level;
-        self.inner = (0, 0.0);
         self.at.clear();
-        // Row by row (the rows below, at and above the points read), the same sums as
-        // `at(i ± 1, j)`, `at(i, j ± 1)` and `at(i ± 1, j ∓ 1)` in the same order.
-        for j in 1..level {
-            let (below, here, above) = (
-                row(points, level, j - 1),
-                row(points, level, j),
-                row(points, level, j + 1),
-            );
-            for i in 1..(level - j) as usize {
-                let p = &here[i];
-                let centre = 2.0 * p.position;
-                let along = |d: DVec3| d.dot(p.normal);
-                self.at.push([
-                    along(here[i - 1].position - centre + here[i + 1].position),
-                    along(below[i].position - centre + above[i].position),
-                    along(below[i + 1].position - centre + above[i - 1].position),
-                ]);
+        self.at.resize(LatticePart::Interior.len(level), [0.0; 3]);
+        let mut out = self.at.as_mut_slice();
+        let mut worst = 0.0f64;
+        // From row `j − 1` on: rows `j − 1`, `j` and `j + 1` have `L + 2 − j`, `L + 1 − j` and
+        // `L − j` points (`row`).
+        let l = level as usize;
+        let mut rows = points;
+        for j in 1..l {
+            let (below, from_here) = rows.split_at(l + 2 - j);
+            let (here, above) = from_here.split_at(l + 1 - j);
+            rows = from_here;
+            let (row_out, rest) = std::mem::take(&mut out).split_at_mut(l - 1 - j);
+            out = rest;
+            // Point `i` of the row (from 1): `here[i − 1..=i + 1]`, `below[i..=i + 1]`,
+            // `above[i − 1..=i]`, the same sums as `at(i ± 1, j)`, `at(i, j ± 1)` and
+            // `at(i ± 1, j ∓ 1)` in the same order.
+            let windows = here
+                .windows(3)
+                .zip(below[1..].windows(2))
+                .zip(above.windows(2));
+            for (((h, b), a), q) in windows.zip(row_out) {
+                *q = second_differences(&h[1], [&h[0], &h[2], &b[0], &a[1], &b[1], &a[0]]);
+                if bound(*q) > worst {
+                    worst = larger(worst, worst_abs(*q));
+                }
             }
         }
+        self.inner = (EVERY_POINT, worst);
         self.spread = f64::NAN;
     }
 
@@ -308,6 +324,21 @@ fn larger(max: f64, x: f64) -> f64 {
 fn row(points: &[SurfacePoint], level: u32, j: u32) -> &[SurfacePoint] {
     let start = lattice_index(level, 0, j);
     &points[start..start + (level + 1 - j) as usize]
+}
+
+/// The second differences at `p` along its normal, from its neighbours `[i − 1, i + 1, below
+/// i, above i, below i + 1, above i − 1]` as [`Curvature::read`] pairs them:
+/// `(a − 2p) + b` per direction, then the dot product with the normal, as `DVec3` takes it.
+#[inline(always)]
+fn second_differences(p: &SurfacePoint, around: [&SurfacePoint; 6]) -> [f64; 3] {
+    let centre = 2.0 * p.position;
+    let along =
+        |a: &SurfacePoint, b: &SurfacePoint| (a.position - centre + b.position).dot(p.normal);
+    [
+        along(around[0], around[1]),
+        along(around[2], around[3]),
+        along(around[4], around[5]),
+    ]
 }
 
 /// An upper bound of [`worst_abs`]`(q)`, with room for its rounding: each sample's error is at
@@ -1062,6 +1093,46 @@ mod tests {
                     kept.clear();
                     c.keep(&mut kept);
                 }
+            }
+        }
+    }
+
+    /// The second differences [`Curvature::read`] takes row by row through windows are the
+    /// plain formula's at each interior point `(i, j)`, bit for bit, and the inner error it
+    /// takes in the same pass is the largest sample error over all of them.
+    #[test]
+    fn the_second_differences_read_are_the_plain_formula_at_every_point() {
+        for f in smooth_fields() {
+            for level in [3, 4, 7, 16] {
+                let points = height_lattice(level, 1.0, &f);
+                let mut c = Curvature::default();
+                c.read(&points, level);
+                let at = |i: u32, j: u32| &points[lattice_index(level, i, j)];
+                let mut plain = Vec::new();
+                for j in 1..level {
+                    for i in 1..level - j {
+                        let p = at(i, j);
+                        let centre = 2.0 * p.position;
+                        let along = |a: &SurfacePoint, b: &SurfacePoint| {
+                            (a.position - centre + b.position).dot(p.normal)
+                        };
+                        plain.push([
+                            along(at(i - 1, j), at(i + 1, j)),
+                            along(at(i, j - 1), at(i, j + 1)),
+                            along(at(i + 1, j - 1), at(i - 1, j + 1)),
+                        ]);
+                    }
+                }
+                let bits =
+                    |q: &[[f64; 3]]| q.iter().map(|d| d.map(f64::to_bits)).collect::<Vec<_>>();
+                assert_eq!(bits(&c.at), bits(&plain), "level {level}");
+                let worst = plain.iter().map(|&q| worst_abs(q)).fold(0.0, f64::max);
+                assert!(worst > 0.0, "level {level}: a curved field");
+                assert_eq!(
+                    c.inner_error(level).to_bits(),
+                    worst.to_bits(),
+                    "level {level}"
+                );
             }
         }
     }
