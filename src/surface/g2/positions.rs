@@ -21,12 +21,22 @@ use crate::surface::pattern::{
 };
 use crate::surface::{lattice_index, lattice_len, LatticePart, SurfacePoint};
 
-/// The control points a position sums for a pattern whose sums need `edge_rows`, in slot order.
-fn value_rows(edge_rows: EdgeRows) -> &'static [usize] {
+/// The positions of the `L` points of `w` for a pattern whose sums need `edge_rows`: [`values`]
+/// over the control points a position sums, in slot order. Each case passes its rows as an
+/// array of fixed length, so the sums unroll as [`G2Surface::combine`]'s do (through a slice
+/// of rows the compiler kept a loop over them: about 49 instructions a row for two points, five
+/// times the unrolled sums, and as much as a whole point for the chord measurement's vertices).
+#[inline(always)]
+fn values_for<const L: usize, N: LaneNet<L>>(
+    w: &Lanes<L>,
+    own: &N,
+    across: Option<&N>,
+    edge_rows: EdgeRows,
+) -> [DVec3; L] {
     match edge_rows {
-        EdgeRows::All => &ALL_ROWS,
-        EdgeRows::Edge(k) => &EDGE_ROWS[k as usize],
-        EdgeRows::EdgeValues(k) => &EDGE_VALUE_ROWS[k as usize],
+        EdgeRows::All => values(w, own, across, &ALL_ROWS),
+        EdgeRows::Edge(k) => values(w, own, across, &EDGE_ROWS[k as usize]),
+        EdgeRows::EdgeValues(k) => values(w, own, across, &EDGE_VALUE_ROWS[k as usize]),
     }
 }
 
@@ -34,11 +44,11 @@ fn value_rows(edge_rows: EdgeRows) -> &'static [usize] {
 /// `accumulate` adds quantity 0.
 #[inline(always)]
 #[allow(clippy::needless_range_loop)] // As in `accumulate`: the form that unrolls into SIMD.
-fn add_values<const L: usize, N: LaneNet<L>>(
+fn add_values<const L: usize, const R: usize, N: LaneNet<L>>(
     w: &NetWeights<L>,
     net: &N,
     acc: &mut [[f64; L]; 3],
-    rows: &[usize],
+    rows: &[usize; R],
 ) {
     for &m in rows {
         for c in 0..3 {
@@ -52,13 +62,13 @@ fn add_values<const L: usize, N: LaneNet<L>>(
 
 /// The positions of the `L` points of `w`, on `own` and, when they blend, `across`: the
 /// position [`G2Surface::combine`] gives, bit for bit, for the rows `rows` of
-/// [`value_rows`].
+/// [`values_for`].
 #[inline(always)]
-fn values<const L: usize, N: LaneNet<L>>(
+fn values<const L: usize, const R: usize, N: LaneNet<L>>(
     w: &Lanes<L>,
     own: &N,
     across: Option<&N>,
-    rows: &[usize],
+    rows: &[usize; R],
 ) -> [DVec3; L] {
     let mut acc = [[0.0; L]; 3];
     add_values(&w.own, own, &mut acc, rows);
@@ -109,7 +119,7 @@ impl<F: Fn(u32) -> usize> PointSink for Positions<'_, F> {
         _split: Option<&Split>,
         edge_rows: EdgeRows,
     ) {
-        let positions = values(lanes, own, across, value_rows(edge_rows));
+        let positions = values_for(lanes, own, across, edge_rows);
         for (&target, p) in lanes.target.iter().zip(positions) {
             if target != Lanes::<1>::PADDING {
                 self.out[(self.slot)(target)].position = p;
