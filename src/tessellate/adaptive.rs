@@ -25,7 +25,7 @@ use super::layout::GroupLayout;
 use super::transition::{Pattern, PatternKey};
 use super::{DenseMesh, VertexSource, BLOCK_TRIANGLES};
 use crate::mesh::TriMesh;
-use crate::surface::Surface;
+use crate::surface::{LatticePart, Surface};
 use crate::topology::Topology;
 
 /// Tessellates `groups` of `mesh` with `counts`; `h` as for [`super::tessellate`].
@@ -174,11 +174,23 @@ fn tessellate_block(
     let (mesh, topo, surface) = (shared.mesh, shared.topo, shared.surface);
     let mut writer = emit::TriangleWriter::new(mesh, topo, surface);
     let mut local: Vec<u32> = Vec::new();
+    let mut parts = Vec::with_capacity(4);
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
         let pattern = shared.pattern(tri);
         let corners = mesh.triangles[tri];
         let owns = layout.owns[offset];
+        let held = shared.held.get(tri, pattern.key.inner);
+        if held.is_none() && !pattern.interior_by_rank.is_empty() {
+            parts.clear();
+            parts.extend(
+                (0..3u8)
+                    .filter(|&k| pattern.key.edges[k as usize] > 1 && owns & (8 << k) != 0)
+                    .map(|k| (pattern.key.edges[k as usize], LatticePart::Edge(k))),
+            );
+            parts.push((pattern.key.inner, LatticePart::Interior));
+            writer.evaluate_parts(tri, &parts);
+        }
         let source = |p: usize| {
             let [level, i, j] = pattern.lattice[p];
             VertexSource {
@@ -216,7 +228,7 @@ fn tessellate_block(
                 .interior_by_rank
                 .iter()
                 .map(|&index| (start + index as usize, index as usize));
-            match shared.held.get(tri, pattern.key.inner) {
+            match held {
                 Some(points) => held::write_interior(
                     &mut block, &mut local, points, first_slot, by_rank, source,
                 ),
