@@ -181,6 +181,9 @@ fn tessellate_block(
         let corners = mesh.triangles[tri];
         let owns = layout.owns[offset];
         let held = shared.held.get(tri, pattern.key.inner);
+        // Evaluated here, the interior and the owned edges share one set-up of the triangle
+        // (its net and the neighbours' composed nets) instead of one per call; a held
+        // interior needs no evaluation, and its edges alone gain nothing from a batch.
         if held.is_none() && !pattern.interior_by_rank.is_empty() {
             parts.clear();
             parts.extend(
