@@ -347,9 +347,9 @@ impl ChordErrors {
     ///    probe's scale its counts are those of stage 1, which then checks each triangle about
     ///    once (10k icosphere at the error level 16 reaches: the same counts and output bytes,
     ///    11,100 lattices finer than the probe's evaluated instead of 23,828). Its checks read
-    ///    the probe's lattice as the probe kept it (`ChordErrors::probed`): it evaluates none Patterns finer than
-    ///    [`MEASURED_UP_TO`] start where the wave would take them
-    ///    ([`ChordErrors::flooded_levels`]), so that it settles in a few rounds;
+    ///    the probe's lattice as the probe kept it (`ChordErrors::probed`): it evaluates none.
+    ///    Patterns finer than `MEASURED_UP_TO` (inner level 12) start where the wave would take
+    ///    them (`ChordErrors::flooded_levels`), so that it settles in a few rounds;
     /// 1. predicted from the lattice at the pattern's own resolution (`estimate.rs`: one lattice
     ///    evaluation per triangle through the surface's cached weights, its second differences
     ///    along the normal), where the counts settle at a quarter of the points of
