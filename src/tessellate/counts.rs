@@ -38,7 +38,7 @@ use super::held::{HeldInteriors, Holding};
 use super::transition::{Pattern, PatternKey};
 use crate::mesh::TriMesh;
 use crate::surface::{lattice_index, Surface, SurfacePoint};
-use crate::topology::Topology;
+use crate::topology::{EdgeId, Topology};
 
 /// Lattice level of the probe: 28 surface points per triangle, a fifth of what level 16
 /// writes, and enough second differences to see a blending region's curvature.
@@ -273,32 +273,13 @@ impl ChordErrors {
         let reference = MEASURED_UP_TO + 1;
         let errors = self.uniform_errors(reference, predicted)?;
         let scale = |n: u32| (f64::from(reference) / f64::from(n)).powi(2);
-        let mut inner: Vec<u32> = errors
+        let inner: Vec<u32> = errors
             .iter()
             .map(|&e| segments_for(e * scale(1), predicted, cap, 1.0))
             .map(|n| if n > MEASURED_UP_TO { n } else { 0 })
             .collect();
-        let mut edges = vec![0u32; topo.edge_count()];
-        loop {
-            for (&n, tri_edges) in inner.iter().zip(&topo.tri_edges) {
-                for e in tri_edges {
-                    let count = &mut edges[e.0 as usize];
-                    *count = (*count).max(n);
-                }
-            }
-            let mut changed = false;
-            for ((n, tri_edges), &e) in inner.iter_mut().zip(&topo.tri_edges).zip(&errors) {
-                let finest = tri_edges.iter().map(|e| edges[e.0 as usize]).max();
-                let finest = finest.unwrap_or(0);
-                if *n > 0 && finest > *n && TRANSITION * e * scale(*n) > predicted {
-                    *n = finest;
-                    changed = true;
-                }
-            }
-            if !changed {
-                return Some((inner, edges));
-            }
-        }
+        let lacks_slack = |t: usize, n: u32| TRANSITION * errors[t] * scale(n) > predicted;
+        Some(flood(topo, inner, lacks_slack))
     }
 
     /// Per triangle, the stage-0 model's error of the uniform pattern of level `reference` on
@@ -803,6 +784,55 @@ impl DecidingParts {
     }
 }
 
+/// The levels of [`ChordErrors::flooded_levels`] from per-triangle levels `inner` (0: not
+/// taking part): edges take the finer of their triangles', and a taking-part triangle whose
+/// level `lacks_slack` for a transition pattern takes its finest edge's, until nothing
+/// moves. Rounds in step: every triangle decides on the edges as its round found them.
+fn flood(
+    topo: &Topology,
+    mut inner: Vec<u32>,
+    lacks_slack: impl Fn(usize, u32) -> bool,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut edges = vec![0u32; topo.edge_count()];
+    for (&n, tri_edges) in inner.iter().zip(&topo.tri_edges) {
+        for e in tri_edges {
+            let count = &mut edges[e.0 as usize];
+            *count = (*count).max(n);
+        }
+    }
+    // Rounds in step (every triangle decides on the edges as the round found them); after
+    // the first only triangles beside an edge the last round raised can move, so a round
+    // costs what moved, whatever the distance the levels travel.
+    let mut candidates: Vec<usize> = (0..inner.len()).collect();
+    let mut touched = Touched::new(inner.len());
+    loop {
+        let moved: Vec<(usize, u32)> = candidates
+            .iter()
+            .filter_map(|&t| {
+                let n = inner[t];
+                let finest = topo.tri_edges[t].iter().map(|e| edges[e.0 as usize]).max();
+                let finest = finest.unwrap_or(0);
+                let moves = n > 0 && finest > n && lacks_slack(t, n);
+                moves.then_some((t, finest))
+            })
+            .collect();
+        if moved.is_empty() {
+            return (inner, edges);
+        }
+        for &(t, n) in &moved {
+            inner[t] = n;
+            for &e in &topo.tri_edges[t] {
+                let count = &mut edges[e.0 as usize];
+                if *count < n {
+                    *count = n;
+                    touched.edge(topo, e);
+                }
+            }
+        }
+        candidates = touched.take_sorted();
+    }
+}
+
 /// The segments a part of error constant `c` needs for `tolerance` with `margin`:
 /// `⌈√(margin · c / tolerance)⌉`, between 1 and `cap`.
 fn segments_for(c: f64, tolerance: f64, cap: u32, margin: f64) -> u32 {
@@ -935,24 +965,31 @@ impl SegmentCounts {
         // back round after round (on the 10k icosphere at the error level 16 reaches, 502
         // builds over the stages), and a build depends on its key alone.
         let mut built: HashMap<PatternKey, P, BuildHasherDefault<KeyHasher>> = HashMap::default();
+        // The triangles whose counts may have changed since their last check, ascending; a
+        // round costs what they are, not the mesh (on a long tube the raise crosses it one ring
+        // per round, thousands of rounds).
+        let mut touched = Touched::new(self.inner.len());
+        let mut dirty: Vec<usize> = (0..self.inner.len()).collect();
         loop {
-            let keys: Vec<PatternKey> = (0..self.inner.len()).map(|t| self.key(topo, t)).collect();
-            let mut distinct: Vec<PatternKey> = keys
+            let to_check: Vec<(usize, PatternKey)> = dirty
                 .iter()
-                .zip(&checked)
-                .filter(|(k, c)| c.as_ref() != Some(k) && !built.contains_key(k))
-                .map(|(k, _)| *k)
+                .map(|&t| (t, self.key(topo, t)))
+                .filter(|(t, k)| checked[*t].as_ref() != Some(k))
+                .collect();
+            let mut distinct: Vec<PatternKey> = to_check
+                .iter()
+                .map(|&(_, k)| k)
+                .filter(|k| !built.contains_key(k))
                 .collect();
             distinct.sort_unstable();
             distinct.dedup();
             let fresh: Vec<P> = distinct.par_iter().map(|&k| build(k)).collect();
             built.extend(distinct.into_iter().zip(fresh));
             // Per checked triangle, in order: its errors and what it kept, if anything.
-            let results: Vec<(usize, PatternError, Vec<K>)> = (0..keys.len())
-                .into_par_iter()
-                .filter(|&t| checked[t].as_ref() != Some(&keys[t]))
-                .map_init(S::default, |scratch, t| {
-                    let p = built.get(&keys[t]).expect("every key to check was built");
+            let results: Vec<(usize, PatternError, Vec<K>)> = to_check
+                .par_iter()
+                .map_init(S::default, |scratch, &(t, key)| {
+                    let p = built.get(&key).expect("every key to check was built");
                     let mut keep = Vec::new();
                     let error = check(t, p, scratch, &kept[t], &mut keep);
                     (t, error, keep)
@@ -969,57 +1006,120 @@ impl SegmentCounts {
             // failing triangles takes the larger, not both in turn.
             let mut raised = false;
             for (t, error) in over {
-                let (inner, edges) = raise_of(keys[t], &error, tolerance, cap);
+                let key = checked_key(&to_check, t);
+                let (inner, edges) = raise_of(key, &error, tolerance, cap);
                 raised |= inner > self.inner[t];
+                if inner != self.inner[t] {
+                    touched.triangle(t);
+                }
                 self.inner[t] = inner;
                 for (e, next) in topo.tri_edges[t].into_iter().zip(edges) {
                     let count = &mut self.edges[e.0 as usize];
-                    raised |= next > *count;
-                    *count = (*count).max(next);
+                    if next > *count {
+                        raised = true;
+                        *count = next;
+                        touched.edge(topo, e);
+                    }
                 }
             }
-            for (c, k) in checked.iter_mut().zip(keys) {
-                *c = Some(k);
+            for &(t, k) in &to_check {
+                checked[t] = Some(k);
             }
             if !raised {
                 return;
             }
-            self.balance(topo);
+            let seeds = touched.pending();
+            self.balance_from(topo, seeds, &mut touched);
+            dirty = touched.take_sorted();
         }
     }
 
     /// Applies the two balance rules of the module docs until neither raises anything.
     fn balance(&mut self, topo: &Topology) {
-        loop {
-            let mut changed = false;
-            for (inner, edges) in self.inner.iter_mut().zip(&topo.tri_edges) {
-                let need = inner_floor(
-                    edges
-                        .iter()
-                        .map(|e| self.edges[e.0 as usize])
-                        .max()
-                        .unwrap_or(1),
-                );
-                if *inner < need {
-                    *inner = need;
-                    changed = true;
-                }
+        let mut touched = Touched::new(self.inner.len());
+        self.balance_from(topo, (0..self.inner.len()).collect(), &mut touched);
+    }
+
+    /// [`SegmentCounts::balance`] where only the triangles `seeds` (and those their raises
+    /// reach) can break a rule: a worklist, so the cost follows what changes. Both rules only
+    /// raise, each to a value that grows with the others (an inner level to the floor of its
+    /// finest edge, an edge to half the finer inner level beside it), so in any order they
+    /// settle on the same counts: the least ones at or above the start that keep both. Every
+    /// triangle whose counts change is noted in `touched`.
+    fn balance_from(&mut self, topo: &Topology, seeds: Vec<usize>, touched: &mut Touched) {
+        let mut work = seeds;
+        while let Some(t) = work.pop() {
+            let finest = topo.tri_edges[t]
+                .iter()
+                .map(|e| self.edges[e.0 as usize])
+                .max()
+                .unwrap_or(1);
+            let need = inner_floor(finest);
+            if self.inner[t] < need {
+                self.inner[t] = need;
+                touched.triangle(t);
             }
-            for (&inner, edges) in self.inner.iter().zip(&topo.tri_edges) {
-                let need = inner.div_ceil(2);
-                for e in edges {
-                    let count = &mut self.edges[e.0 as usize];
-                    if *count < need {
-                        *count = need;
-                        changed = true;
-                    }
+            let half = self.inner[t].div_ceil(2);
+            for &e in &topo.tri_edges[t] {
+                let count = &mut self.edges[e.0 as usize];
+                if *count < half {
+                    *count = half;
+                    touched.edge(topo, e);
+                    work.extend(topo.edge_uses(e).iter().map(|u| u.tri().0 as usize));
                 }
-            }
-            if !changed {
-                break;
             }
         }
     }
+}
+
+/// The triangles whose counts changed (their inner level, or an edge of theirs), each once.
+struct Touched {
+    marked: Vec<bool>,
+    list: Vec<usize>,
+}
+
+impl Touched {
+    fn new(triangles: usize) -> Touched {
+        Touched {
+            marked: vec![false; triangles],
+            list: Vec::new(),
+        }
+    }
+
+    fn triangle(&mut self, t: usize) {
+        if !std::mem::replace(&mut self.marked[t], true) {
+            self.list.push(t);
+        }
+    }
+
+    fn edge(&mut self, topo: &Topology, e: EdgeId) {
+        for u in topo.edge_uses(e) {
+            self.triangle(u.tri().0 as usize);
+        }
+    }
+
+    /// The triangles noted so far, still noted.
+    fn pending(&self) -> Vec<usize> {
+        self.list.clone()
+    }
+
+    /// The triangles noted, ascending, and forgets them.
+    fn take_sorted(&mut self) -> Vec<usize> {
+        let mut list = std::mem::take(&mut self.list);
+        for &t in &list {
+            self.marked[t] = false;
+        }
+        list.sort_unstable();
+        list
+    }
+}
+
+/// The key triangle `t` was checked with this round (`to_check` is ascending by triangle).
+fn checked_key(to_check: &[(usize, PatternKey)], t: usize) -> PatternKey {
+    let at = to_check
+        .binary_search_by_key(&t, |&(u, _)| u)
+        .expect("a failing triangle was checked");
+    to_check[at].1
 }
 
 #[cfg(test)]
@@ -1119,5 +1219,141 @@ mod tests {
             stopped > checks / 10,
             "{stopped} of {checks} reads stopped early"
         );
+    }
+
+    /// A small deterministic generator for the tests below.
+    fn lcg(seed: u64) -> impl FnMut(u32) -> u32 {
+        let mut state = seed;
+        move |n| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 33) % u64::from(n)) as u32
+        }
+    }
+
+    /// The rules swept over every triangle and edge until neither raises anything: the
+    /// balance as first written, which the worklist must match.
+    fn balanced_by_sweeps(counts: &mut SegmentCounts, topo: &Topology) {
+        loop {
+            let mut changed = false;
+            for (inner, edges) in counts.inner.iter_mut().zip(&topo.tri_edges) {
+                let finest = edges.iter().map(|e| counts.edges[e.0 as usize]).max();
+                let need = inner_floor(finest.unwrap_or(1));
+                if *inner < need {
+                    *inner = need;
+                    changed = true;
+                }
+            }
+            for (&inner, edges) in counts.inner.iter().zip(&topo.tri_edges) {
+                for e in edges {
+                    let count = &mut counts.edges[e.0 as usize];
+                    if *count < inner.div_ceil(2) {
+                        *count = inner.div_ceil(2);
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                return;
+            }
+        }
+    }
+
+    /// The worklist balance gives the sweeps' counts, from scratch and from a few raised
+    /// counts with only the triangles they touch as seeds, and notes every triangle whose
+    /// counts it changed; on meshes with books, fans and open edges.
+    #[test]
+    fn the_worklist_balance_settles_where_the_sweeps_do() {
+        for seed in 0..40u64 {
+            let topo = Topology::build(&crate::topology::tests::odd_mesh(
+                seed,
+                30 + 11 * seed as usize,
+            ));
+            let mut next = lcg(seed);
+            let mut counts = SegmentCounts::uniform(&topo, 1);
+            counts.edges.iter_mut().for_each(|c| *c = 1 + next(24));
+            counts.inner.iter_mut().for_each(|c| *c = 1 + next(24));
+            let mut swept = counts.clone();
+            balanced_by_sweeps(&mut swept, &topo);
+            counts.balance(&topo);
+            assert_eq!(counts, swept, "seed {seed}: from scratch");
+
+            let before = counts.clone();
+            let mut touched = Touched::new(counts.inner.len());
+            for _ in 0..3 {
+                let t = next(counts.inner.len() as u32) as usize;
+                counts.inner[t] += 1 + next(20);
+                touched.triangle(t);
+                let e = topo.tri_edges[t][next(3) as usize];
+                counts.edges[e.0 as usize] += 1 + next(30);
+                touched.edge(&topo, e);
+            }
+            let mut swept = counts.clone();
+            balanced_by_sweeps(&mut swept, &topo);
+            let seeds = touched.pending();
+            counts.balance_from(&topo, seeds, &mut touched);
+            assert_eq!(counts, swept, "seed {seed}: from raised counts");
+            let noted = touched.take_sorted();
+            for t in 0..counts.inner.len() {
+                let changed = counts.key(&topo, t) != before.key(&topo, t);
+                assert!(
+                    !changed || noted.binary_search(&t).is_ok(),
+                    "seed {seed}: {t} not noted"
+                );
+            }
+        }
+    }
+
+    /// The flood's worklist rounds give the levels of rounds over every triangle in step, for
+    /// a slack that depends on the triangle and its level (so the order of moves matters).
+    #[test]
+    fn the_flood_moves_as_rounds_over_every_triangle_do() {
+        let mut moved_in_all = 0;
+        for seed in 0..40u64 {
+            let topo = Topology::build(&crate::topology::tests::odd_mesh(
+                seed,
+                30 + 11 * seed as usize,
+            ));
+            let mut next = lcg(seed + 1000);
+            let start: Vec<u32> = topo
+                .tri_edges
+                .iter()
+                .map(|_| if next(3) == 0 { 0 } else { 13 + next(8) })
+                .collect();
+            let lacks = |t: usize, n: u32| (t as u32 * 7 + n * 3) % 5 != 0;
+            let mut inner = start.clone();
+            let mut edges = vec![0u32; topo.edge_count()];
+            loop {
+                for (&n, tri_edges) in inner.iter().zip(&topo.tri_edges) {
+                    for e in tri_edges {
+                        edges[e.0 as usize] = edges[e.0 as usize].max(n);
+                    }
+                }
+                let mut changed = false;
+                for (t, (n, tri_edges)) in inner.iter_mut().zip(&topo.tri_edges).enumerate() {
+                    let finest = tri_edges
+                        .iter()
+                        .map(|e| edges[e.0 as usize])
+                        .max()
+                        .unwrap_or(0);
+                    if *n > 0 && finest > *n && lacks(t, *n) {
+                        *n = finest;
+                        changed = true;
+                    }
+                }
+                if !changed {
+                    break;
+                }
+            }
+            let moved = inner.iter().zip(&start).filter(|(a, b)| a != b).count();
+            moved_in_all += moved;
+            assert_eq!(
+                flood(&topo, start, lacks),
+                (inner, edges),
+                "seed {seed} ({moved} moved)"
+            );
+        }
+        assert!(moved_in_all > 100, "the cases move little: {moved_in_all}");
     }
 }
