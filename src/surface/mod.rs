@@ -149,6 +149,29 @@ pub trait Surface: Sync {
         out.extend(barys.iter().map(|&b| self.evaluate(tri, b)));
     }
 
+    /// [`Surface::evaluate_points`] handed out `run` points at a time (the last run may be
+    /// shorter): `each` is called with every run in order, as `out` holds it (cleared before
+    /// each run), and the evaluation stops as soon as it returns `false`. The same points, bit
+    /// for bit. A check that can fail on any output triangle's samples (`tessellate::chord`'s
+    /// early-exit check) then evaluates only as far as the first that fails; a surface that
+    /// sets a triangle up per call should set it up once for all the runs, as G2Surface does.
+    fn evaluate_points_while(
+        &self,
+        tri: usize,
+        barys: &[[f64; 3]],
+        run: usize,
+        out: &mut Vec<SurfacePoint>,
+        each: &mut dyn FnMut(&[SurfacePoint]) -> bool,
+    ) {
+        out.clear();
+        self.evaluate_points(tri, barys, out);
+        for points in out.chunks(run.max(1)) {
+            if !each(points) {
+                return;
+            }
+        }
+    }
+
     /// [`Surface::evaluate_lattice`] for a caller that reads the normals of the interior points
     /// only: every position, and the corners' and interior points' normals, are those
     /// [`Surface::evaluate_lattice`] gives, bit for bit; the normals of the other edge points

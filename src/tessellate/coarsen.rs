@@ -27,7 +27,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use super::chord::{measured_error, Samples};
+use super::chord::{measured_within, Samples};
 use super::counts::{inner_floor, SegmentCounts};
 use super::fill::fill_within;
 use super::transition::{Pattern, PatternKey};
@@ -154,7 +154,7 @@ pub(crate) fn coarsen(
             .par_iter()
             .map_init(Samples::default, |samples, &t| {
                 let key = counts.key(topo, t);
-                if measured_error(surface, t, &built[&key], samples).within(tolerance) {
+                if measured_within(surface, t, &built[&key], tolerance, samples) {
                     return Some(0);
                 }
                 if key.inner >= 3 {
@@ -162,9 +162,7 @@ pub(crate) fn coarsen(
                 }
                 let fill = fill_within(surface, t, key, tolerance, samples)?;
                 let filled = Pattern::new(PatternKey { fill, ..key });
-                measured_error(surface, t, &filled, samples)
-                    .within(tolerance)
-                    .then_some(fill)
+                measured_within(surface, t, &filled, tolerance, samples).then_some(fill)
             })
             .collect();
         let passes_at = |t: usize| passes[checked.binary_search(&t).expect("checked")];

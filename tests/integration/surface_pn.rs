@@ -372,3 +372,64 @@ fn positions_alone_equal_the_whole_evaluation_bit_for_bit() {
         }
     });
 }
+
+/// The check that stops at the first output triangle over its tolerance asks for a triangle's
+/// points in runs: the runs, all accepted, must be the points evaluated whole, bit for bit, at
+/// any run length (one, the seven samples of a triangle, more than there are), on split
+/// normals and with some edges at h = 0, through the PN surface's forwarding too; and a run
+/// refused must be the last one handed out.
+#[test]
+fn points_in_runs_equal_the_whole_evaluation_and_stop_when_refused() {
+    let check = |s: &dyn Surface, t: usize, barys: &[[f64; 3]]| {
+        let mut whole = Vec::new();
+        s.evaluate_points(t, barys, &mut whole);
+        for run in [1, 7, barys.len() + 3] {
+            let (mut handed, mut scratch) = (Vec::new(), Vec::new());
+            s.evaluate_points_while(t, barys, run, &mut scratch, &mut |points| {
+                assert!(points.len() <= run, "triangle {t} run {run}");
+                handed.extend_from_slice(points);
+                true
+            });
+            assert_eq!(handed.len(), whole.len(), "triangle {t} run {run}");
+            for (x, (h, w)) in handed.iter().zip(&whole).enumerate() {
+                assert_eq!(bits(h.position), bits(w.position), "triangle {t} point {x}");
+                assert_eq!(bits(h.normal), bits(w.normal), "triangle {t} point {x}");
+            }
+            let mut calls = 0;
+            s.evaluate_points_while(t, barys, run, &mut scratch, &mut |_| {
+                calls += 1;
+                calls < 2
+            });
+            assert_eq!(
+                calls,
+                2.min(barys.len().div_ceil(run)),
+                "triangle {t} run {run}"
+            );
+        }
+    };
+    let random_barys = |rng: &mut Lcg| -> Vec<[f64; 3]> {
+        let mut barys = vec![[0.0, 1.0, 0.0], [0.5, 0.0, 0.5]];
+        for _ in 0..40 {
+            let (u, v) = (rng.next(), rng.next());
+            let (u, v) = if u + v > 1.0 {
+                (1.0 - u, 1.0 - v)
+            } else {
+                (u, v)
+            };
+            barys.push([1.0 - u - v, u, v]);
+        }
+        barys
+    };
+    random_h_surfaces(&mut Lcg(53), |s, mesh, rng| {
+        for t in 0..mesh.triangles.len() {
+            check(s, t, &random_barys(rng));
+        }
+    });
+    let mesh = split_normals(&bumpy_sphere(), 0.5);
+    let topo = Topology::build(&mesh);
+    let pn = PnSurface::new(&mesh, &topo);
+    let mut rng = Lcg(59);
+    for t in 0..mesh.triangles.len() {
+        check(&pn, t, &random_barys(&mut rng));
+    }
+}
