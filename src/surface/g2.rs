@@ -148,8 +148,9 @@ pub struct G2Surface<'a> {
     patches: Patches,
     profile: Profile,
     patterns: PatternCache,
-    /// The weights of the scattered point sets asked for again and again ([`point_sets`]).
-    point_sets: point_sets::PointSets,
+    /// The weights of the scattered point sets asked for again and again ([`point_sets`]), a
+    /// store per size of set ([`point_sets::TIERS`]).
+    point_sets: point_sets::PointSetStores,
     /// The weights of the points a lattice adds to the one of half its level ([`refine`]).
     odd_points: refine::OddPointsCache,
     /// This surface's tag in the per-thread memo of rebuilt nets ([`net_memo`]).
@@ -252,7 +253,7 @@ impl<'a> G2Surface<'a> {
             patches,
             profile,
             patterns: PatternCache::default(),
-            point_sets: point_sets::PointSets::new(point_sets::MAX_SETS),
+            point_sets: point_sets::PointSetStores::default(),
             odd_points: refine::OddPointsCache::new(refine::MAX_LEVELS),
             memo_owner: net_memo::new_owner(),
         };

@@ -122,7 +122,9 @@ fn triangle_errors(
         samples.barys.extend(sample_barys(pattern, t));
     }
     samples.points.clear();
-    surface.evaluate_points(tri, &samples.barys, &mut samples.points);
+    // Every sample whole, through the surface's kept weights where it keeps them (the same
+    // samples for every source triangle with this pattern).
+    surface.evaluate_points_positions_first(tri, &samples.barys, 0, &mut samples.points);
     for (t, on_surface) in chosen.zip(samples.points.chunks_exact(WEIGHTS.len())) {
         each(
             t,

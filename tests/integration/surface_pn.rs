@@ -353,9 +353,26 @@ fn positions_alone_equal_the_whole_evaluation_bit_for_bit() {
                     [1.0 - u - v, u, v]
                 })
                 .collect();
+            // Sets of the sizes the whole-pattern measurements ask for, kept in the stores of
+            // larger sets, and one too large to keep, evaluated point by point (on a few
+            // triangles: thousands of points each).
+            let large = |n: u32| -> Vec<[f64; 3]> {
+                (0..n)
+                    .map(|x| {
+                        let (u, v) = (f64::from(x % 97) / 200.0, f64::from(x / 97) / 200.0);
+                        [1.0 - u - v, u, v]
+                    })
+                    .collect()
+            };
+            let larger: Vec<Vec<[f64; 3]>> = if t < 3 {
+                [700, 700, 3000, 3000, 7300].map(large).into()
+            } else {
+                Vec::new()
+            };
             for (set, first) in [(&fixed, 12), (&fixed, 12), (&barys, 0), (&barys, 5)]
                 .into_iter()
                 .chain([(&barys, barys.len())])
+                .chain(larger.iter().map(|set| (set, 0)))
             {
                 let barys = set;
                 let (mut whole, mut fast) = (Vec::new(), Vec::new());

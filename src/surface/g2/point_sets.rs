@@ -7,7 +7,10 @@
 //!
 //! A set is found by its points' bits, not by a name the caller gives: a hash picks the entry,
 //! and the entry's points are compared before it is used, so a set is never taken for another.
-//! Past [`MAX_SETS`] kept, points are evaluated one by one as before, with the same bits.
+//! The chord error measurement of whole patterns (seven samples of every output triangle: the
+//! tolerance checks' and the report's) asks for sets too, one per pattern and width triple, far
+//! larger; they are kept in stores of their own ([`TIERS`]). Past the bounds, points are
+//! evaluated one by one as before, with the same bits.
 
 use std::hash::{Hash, Hasher};
 
@@ -17,9 +20,35 @@ use crate::surface::lattice_cache::LatticeCache;
 use crate::surface::pattern::Pattern;
 use crate::surface::{LatticePart, Profile, SurfacePoint};
 
-/// Most sets kept: about 20 kB each for the corner measurement's 40 points (the 10k icosphere
-/// at the error level 16 reaches uses about 100), so at most about 5 MB.
-pub(super) const MAX_SETS: usize = 256;
+/// The stores of sets by size: `(most points of a set, most sets kept)`, a set going to the
+/// first whose size it fits. Weights take about 520 bytes per point (a whole level-16 lattice,
+/// 153 points, about 80 kB). Sets are kept in the order first asked for; past a store's count,
+/// or past the largest size, points are evaluated one by one: a bound on speed, never a
+/// difference in bits. Each size has its own store so that the many large sets neither take
+/// the small ones' places nor grow past a few tens of megabytes.
+pub(super) const TIERS: [(usize, usize); 3] = [
+    // A pattern's corner triangles' vertices and samples (the corner measurement's 40
+    // points; the 10k icosphere at the error level 16 reaches uses about 100 sets): at most
+    // about 8 MB.
+    (64, 256),
+    // The seven samples of each of the 144 output triangles of a pattern of inner level 12,
+    // the finest the tolerance checks measure at every output triangle
+    // (`tessellate::counts`), one set per pattern and width triple: at most about 33 MB.
+    (7 * 144, 64),
+    // The report's measurement of every output triangle, up to a uniform level 32's 1,024
+    // (about 3.7 MB a set): at most about 30 MB. Finer patterns are measured point by point.
+    (7 * 1024, 8),
+];
+
+/// One store per entry of [`TIERS`].
+#[derive(Debug)]
+pub(super) struct PointSetStores([PointSets; TIERS.len()]);
+
+impl Default for PointSetStores {
+    fn default() -> Self {
+        PointSetStores(TIERS.map(|(_, sets)| PointSets::new(sets)))
+    }
+}
 
 /// A set's key: its points' hash, how many are positions alone, the widths' bits, the profile.
 type Key = (u64, usize, [u64; 3], Profile);
@@ -77,6 +106,13 @@ impl G2Surface<'_> {
         positions_only: usize,
         out: &mut Vec<SurfacePoint>,
     ) -> bool {
+        let Some(sets) = TIERS
+            .iter()
+            .zip(&self.point_sets.0)
+            .find_map(|(&(points, _), sets)| (barys.len() <= points).then_some(sets))
+        else {
+            return false;
+        };
         let widths = self.widths(tri);
         let key = (
             hash_points(barys),
@@ -89,7 +125,7 @@ impl G2Surface<'_> {
             positions: Pattern::at_points(&barys[..positions_only], widths, self.profile),
             whole: Pattern::at_points(&barys[positions_only..], widths, self.profile),
         };
-        let Some(set) = self.point_sets.get_or_build(key, build) else {
+        let Some(set) = sets.get_or_build(key, build) else {
             return false;
         };
         let same = set.barys.len() == barys.len()
