@@ -151,10 +151,11 @@ pub trait Surface: Sync {
 
     /// [`Surface::evaluate_points`] handed out `run` points at a time (the last run may be
     /// shorter): `each` is called with every run in order, as `out` holds it (cleared before
-    /// each run), and the evaluation stops as soon as it returns `false`. The same points, bit
-    /// for bit. A check that can fail on any output triangle's samples (`tessellate::chord`'s
-    /// early-exit check) then evaluates only as far as the first that fails; a surface that
-    /// sets a triangle up per call should set it up once for all the runs, as G2Surface does.
+    /// each run), and no point past a run it refuses (returns `false` for) is evaluated. The
+    /// same points, bit for bit. A check that can fail on any output triangle's samples
+    /// (`tessellate::chord`'s early-exit check) then evaluates only as far as the first that
+    /// fails. Here each run is one [`Surface::evaluate_points`] call; a surface that sets a
+    /// triangle up per call should set it up once for all the runs, as G2Surface does.
     fn evaluate_points_while(
         &self,
         tri: usize,
@@ -163,10 +164,10 @@ pub trait Surface: Sync {
         out: &mut Vec<SurfacePoint>,
         each: &mut dyn FnMut(&[SurfacePoint]) -> bool,
     ) {
-        out.clear();
-        self.evaluate_points(tri, barys, out);
-        for points in out.chunks(run.max(1)) {
-            if !each(points) {
+        for run in barys.chunks(run.max(1)) {
+            out.clear();
+            self.evaluate_points(tri, run, out);
+            if !each(out) {
                 return;
             }
         }

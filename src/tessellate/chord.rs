@@ -221,22 +221,36 @@ pub(crate) fn measured_error(
     pattern: &Pattern,
     samples: &mut Samples,
 ) -> PatternError {
+    let vertices = written_vertices(surface, tri, pattern, samples);
+    let error = errors_by_part(surface, tri, pattern, |_| true, &vertices, samples);
+    samples.vertices = vertices;
+    error
+}
+
+/// The vertices of source triangle `tri`'s `pattern` as the output writes them, evaluated on
+/// its own side ([`evaluate_pattern_points`]) and rounded to `f32`, in the buffer taken from
+/// `samples` (the caller gives it back).
+fn written_vertices(
+    surface: &dyn Surface,
+    tri: usize,
+    pattern: &Pattern,
+    samples: &mut Samples,
+) -> Vec<DVec3> {
     evaluate_pattern_points(surface, tri, pattern, &mut samples.points);
     let mut vertices = std::mem::take(&mut samples.vertices);
     vertices.clear();
     vertices.extend(samples.points.iter().map(|p| written(p.position)));
-    let error = errors_by_part(surface, tri, pattern, |_| true, &vertices, samples);
-    samples.vertices = vertices;
-    error
+    vertices
 }
 
 /// Whether [`measured_error`] of source triangle `tri` cut by `pattern` is within
 /// `tolerance`, found by measuring output triangle after output triangle and stopping at the
 /// first over it: a check that fails (most of those a coarsening step makes; all 15,000 on a
 /// 5,000-triangle tube at 1e-4) is decided where the first failing triangle lies, there on
-/// average a tenth of the way through, instead of at the end. The same answer, bit for bit: the same vertices, samples and
-/// sums, and a pattern is within exactly when none of its triangles is over (an error that is
-/// not a number is passed over here as the maxima of [`measured_error`] pass over it).
+/// average a tenth of the way through, instead of at the end. The same answer, bit for bit:
+/// the same vertices, samples and sums, and a pattern is within exactly when none of its
+/// triangles is over (an error that is not a number is passed over here as the maxima of
+/// [`measured_error`] pass over it).
 pub(crate) fn measured_within(
     surface: &dyn Surface,
     tri: usize,
@@ -244,10 +258,7 @@ pub(crate) fn measured_within(
     tolerance: f64,
     samples: &mut Samples,
 ) -> bool {
-    evaluate_pattern_points(surface, tri, pattern, &mut samples.points);
-    let mut vertices = std::mem::take(&mut samples.vertices);
-    vertices.clear();
-    vertices.extend(samples.points.iter().map(|p| written(p.position)));
+    let vertices = written_vertices(surface, tri, pattern, samples);
     samples.barys.clear();
     for t in 0..pattern.triangles.len() {
         samples.barys.extend(sample_barys(pattern, t));
@@ -472,31 +483,14 @@ mod tests {
         }
     }
 
-    /// [`Field`] evaluated point by point as a lazy surface would, counting the points it
-    /// evaluates, so that a check that stops early is seen to stop.
+    /// [`Field`] counting the points it evaluates, so that a check that stops early is seen to
+    /// stop (through the trait's own runs of points).
     struct CountingField(std::sync::atomic::AtomicUsize);
 
     impl Surface for CountingField {
         fn evaluate(&self, tri: usize, b: [f64; 3]) -> SurfacePoint {
             self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             Field.evaluate(tri, b)
-        }
-
-        fn evaluate_points_while(
-            &self,
-            tri: usize,
-            barys: &[[f64; 3]],
-            run: usize,
-            out: &mut Vec<SurfacePoint>,
-            each: &mut dyn FnMut(&[SurfacePoint]) -> bool,
-        ) {
-            for run in barys.chunks(run) {
-                out.clear();
-                out.extend(run.iter().map(|&b| self.evaluate(tri, b)));
-                if !each(out) {
-                    return;
-                }
-            }
         }
     }
 

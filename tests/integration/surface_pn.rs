@@ -425,17 +425,11 @@ fn points_in_runs_equal_the_whole_evaluation_and_stop_when_refused() {
         }
     };
     let random_barys = |rng: &mut Lcg| -> Vec<[f64; 3]> {
-        let mut barys = vec![[0.0, 1.0, 0.0], [0.5, 0.0, 0.5]];
-        for _ in 0..40 {
-            let (u, v) = (rng.next(), rng.next());
-            let (u, v) = if u + v > 1.0 {
-                (1.0 - u, 1.0 - v)
-            } else {
-                (u, v)
-            };
-            barys.push([1.0 - u - v, u, v]);
-        }
-        barys
+        let corner_and_edge = [[0.0, 1.0, 0.0], [0.5, 0.0, 0.5]];
+        corner_and_edge
+            .into_iter()
+            .chain((0..40).map(|_| rng.bary(0.0)))
+            .collect()
     };
     random_h_surfaces(&mut Lcg(53), |s, mesh, rng| {
         for t in 0..mesh.triangles.len() {
