@@ -14,6 +14,7 @@
 //! once and shared (`transition.rs`).
 
 use std::ops::Range;
+use std::sync::Arc;
 
 use rayon::prelude::*;
 
@@ -21,6 +22,7 @@ use super::blocks::{self, Block};
 use super::counts::SegmentCounts;
 use super::emit;
 use super::held::{self, HeldInteriors};
+use super::kept_patterns;
 use super::layout::GroupLayout;
 use super::transition::{Pattern, PatternKey};
 use super::{DenseMesh, VertexSource, BLOCK_TRIANGLES};
@@ -73,7 +75,10 @@ pub fn tessellate_with_held(
     let mut distinct = keys.clone();
     distinct.par_sort_unstable();
     distinct.dedup();
-    let patterns: Vec<Pattern> = distinct.par_iter().map(|&k| Pattern::new(k)).collect();
+    let patterns: Vec<Arc<Pattern>> = distinct
+        .par_iter()
+        .map(|&k| kept_patterns::pattern(k))
+        .collect();
     let pattern_of: Vec<u32> = keys
         .par_iter()
         .map(|k| distinct.binary_search(k).expect("every key was built") as u32)
@@ -100,7 +105,7 @@ struct Shared<'a> {
     surface: &'a dyn Surface,
     counts: &'a SegmentCounts,
     held: &'a HeldInteriors,
-    patterns: &'a [Pattern],
+    patterns: &'a [Arc<Pattern>],
     pattern_of: &'a [u32],
 }
 

@@ -31,12 +31,14 @@
 
 use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::Arc;
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::counts::SegmentCounts;
 use super::estimate::PatternError;
+use super::kept_patterns;
 use super::transition::{Pattern, PatternKey};
 use super::DenseMesh;
 use crate::surface::{LatticePart, Surface, SurfacePoint};
@@ -66,14 +68,14 @@ pub fn chord_error(
     dense: &DenseMesh,
 ) -> f64 {
     let keys: Vec<PatternKey> = group.clone().map(|t| counts.key(topo, t)).collect();
-    let mut patterns: HashMap<PatternKey, Pattern> = HashMap::new();
+    let mut patterns: HashMap<PatternKey, Arc<Pattern>> = HashMap::new();
     let mut first_index = Vec::with_capacity(keys.len());
     let mut total = 0usize;
     for &key in &keys {
         first_index.push(total);
         total += 3 * patterns
             .entry(key)
-            .or_insert_with(|| Pattern::new(key))
+            .or_insert_with(|| kept_patterns::pattern(key))
             .triangles
             .len();
     }

@@ -24,12 +24,14 @@
 //! touches has changed. The rounds stop when no step is left to try, or after [`ROUNDS`].
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use rayon::prelude::*;
 
 use super::chord::{measured_within, Samples};
 use super::counts::{inner_floor, SegmentCounts};
 use super::fill::fill_within;
+use super::kept_patterns;
 use super::transition::{Pattern, PatternKey};
 use crate::surface::Surface;
 use crate::topology::{EdgeId, Topology};
@@ -63,7 +65,7 @@ pub(crate) fn coarsen(
     let mut version = vec![0u64; tris];
     let mut failed_edge: Vec<Option<u64>> = vec![None; counts.edges.len()];
     let mut failed_inner: Vec<Option<u64>> = vec![None; tris];
-    let mut built: HashMap<PatternKey, Pattern> = HashMap::new();
+    let mut built: HashMap<PatternKey, Arc<Pattern>> = HashMap::new();
     let mut busy = vec![false; tris];
     for _ in 0..ROUNDS {
         busy.iter_mut().for_each(|b| *b = false);
@@ -146,7 +148,10 @@ pub(crate) fn coarsen(
             .collect();
         fresh.sort_unstable();
         fresh.dedup();
-        let patterns: Vec<Pattern> = fresh.par_iter().map(|&k| Pattern::new(k)).collect();
+        let patterns: Vec<Arc<Pattern>> = fresh
+            .par_iter()
+            .map(|&k| kept_patterns::pattern(k))
+            .collect();
         built.extend(fresh.into_iter().zip(patterns));
         // Per checked triangle, whether it passes and with which fill (0 unless the default
         // fill fails and one chosen by measured error passes).
@@ -161,7 +166,7 @@ pub(crate) fn coarsen(
                     return None;
                 }
                 let fill = fill_within(surface, t, key, tolerance, samples)?;
-                let filled = Pattern::new(PatternKey { fill, ..key });
+                let filled = kept_patterns::pattern(PatternKey { fill, ..key });
                 measured_within(surface, t, &filled, tolerance, samples).then_some(fill)
             })
             .collect();

@@ -35,6 +35,7 @@ use super::coarsen::coarsen;
 use super::estimate::{Curvature, PatternError, PatternModel};
 use super::evaluator;
 use super::held::{HeldInteriors, Holding};
+use super::kept_patterns;
 use super::transition::{Pattern, PatternKey};
 use crate::mesh::TriMesh;
 use crate::surface::{lattice_index, Surface, SurfacePoint};
@@ -406,7 +407,7 @@ impl ChordErrors {
                 topo,
                 predicted,
                 cap,
-                |key| PatternModel::new(&Pattern::new(key), check_level(key.inner, factor)),
+                |key| kept_patterns::model(key, check_level(key.inner, factor)),
                 |tri,
                  model,
                  (points, curvature): &mut (Vec<SurfacePoint>, Curvature),
@@ -487,7 +488,7 @@ impl ChordErrors {
             tolerance,
             cap,
             |key| {
-                let pattern = Pattern::new(key);
+                let pattern = kept_patterns::pattern(key);
                 let corners = (key.inner > MEASURED_UP_TO).then(|| CornerTriangles::new(&pattern));
                 (pattern, corners)
             },

@@ -481,6 +481,13 @@ impl PatternError {
 }
 
 impl PatternModel {
+    /// About the memory the model takes, in bytes (its vectors' contents and itself).
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<PatternModel>()
+            + std::mem::size_of_val(&self.boundary[..])
+            + std::mem::size_of_val(&self.runs[..])
+    }
+
     /// The model of `pattern` over the second differences of a level-`level` lattice (`level`
     /// at least 3). A lattice coarser than the pattern's inner level, as the probe's, serves
     /// too: its second differences, scaled by `L²`, are the same `D²S` (exactly on a quadratic

@@ -22,8 +22,9 @@
 //! at any thread count.
 
 use super::chord::{candidate_errors, Samples};
+use super::kept_patterns;
 use super::transition::{
-    min_angle, polygon, triangulation, triangulations, Pattern, PatternKey, ANGLE_FLOOR,
+    min_angle, polygon, triangulation, triangulations, PatternKey, ANGLE_FLOOR,
 };
 use crate::surface::Surface;
 
@@ -37,7 +38,7 @@ pub(crate) fn fill_within(
     tolerance: f64,
     samples: &mut Samples,
 ) -> Option<u16> {
-    let pattern = Pattern::new(PatternKey { fill: 0, ..key });
+    let pattern = kept_patterns::pattern(PatternKey { fill: 0, ..key });
     let outer = polygon(&pattern);
     let n = outer.len();
     let at = |v: usize| pattern.domain(outer[v]);
@@ -95,6 +96,7 @@ mod tests {
     use super::*;
     use crate::surface::SurfacePoint;
     use crate::tessellate::chord::measured_error;
+    use crate::tessellate::transition::Pattern;
     use glam::DVec3;
 
     /// A cylinder of radius 1 over the reference triangle, its axis along the direction of

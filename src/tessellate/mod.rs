@@ -60,6 +60,7 @@ mod emit;
 mod estimate;
 mod fill;
 mod held;
+mod kept_patterns;
 mod lattice_edges;
 mod layout;
 mod plan;

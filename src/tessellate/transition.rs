@@ -92,6 +92,14 @@ pub(crate) struct Pattern {
 }
 
 impl Pattern {
+    /// About the memory the pattern takes, in bytes (its vectors' contents and itself).
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<Pattern>()
+            + std::mem::size_of_val(&self.lattice[..])
+            + std::mem::size_of_val(&self.interior_by_rank[..])
+            + std::mem::size_of_val(&self.triangles[..])
+    }
+
     /// Builds the pattern of `key`.
     ///
     /// # Panics
