@@ -952,6 +952,16 @@ impl Surface for G2Surface<'_> {
         }
     }
 
+    /// One set-up for every call.
+    fn evaluate_points_on_demand(
+        &self,
+        tri: usize,
+        drive: &mut dyn FnMut(&mut crate::surface::PointsOnDemand<'_>),
+    ) {
+        let mut points = PointEvaluation::new(self, tri);
+        drive(&mut |barys, out| out.extend(barys.iter().map(|&bary| points.at(self, bary))));
+    }
+
     /// The interior through its lattice part's pattern, each edge's positions alone through
     /// its edge part's (`g2::positions`).
     fn evaluate_lattice_positions_on_edges(
@@ -1320,6 +1330,14 @@ impl Surface for PnSurface<'_> {
         each: &mut dyn FnMut(&[SurfacePoint]) -> bool,
     ) {
         self.0.evaluate_points_while(tri, barys, run, out, each)
+    }
+
+    fn evaluate_points_on_demand(
+        &self,
+        tri: usize,
+        drive: &mut dyn FnMut(&mut crate::surface::PointsOnDemand<'_>),
+    ) {
+        self.0.evaluate_points_on_demand(tri, drive)
     }
 
     fn evaluate_lattice_positions_on_edges(

@@ -98,6 +98,10 @@ pub struct SurfacePoint {
     pub normal: DVec3,
 }
 
+/// The function [`Surface::evaluate_points_on_demand`] hands its caller: appends the points at
+/// the barycentrics it is given to the buffer.
+pub type PointsOnDemand<'a> = dyn FnMut(&[[f64; 3]], &mut Vec<SurfacePoint>) + 'a;
+
 /// A smooth surface over every triangle of a mesh.
 pub trait Surface: Sync {
     /// Position and exact unit normal at barycentrics `bary` (sum 1) of triangle `tri`, corners
@@ -171,6 +175,20 @@ pub trait Surface: Sync {
                 return;
             }
         }
+    }
+
+    /// Calls `drive` once with a function that appends the points of triangle `tri` at any
+    /// barycentrics to a buffer, each equal to [`Surface::evaluate_points`]'s bit for bit, for a
+    /// caller that decides which points it needs next from those it has (the fill choice of
+    /// `tessellate::fill` measures a candidate triangle only where it could change the choice).
+    /// Here each call is one [`Surface::evaluate_points`] call; a surface that sets a triangle
+    /// up per call should set it up once for all of them, as G2Surface does.
+    fn evaluate_points_on_demand(
+        &self,
+        tri: usize,
+        drive: &mut dyn FnMut(&mut PointsOnDemand<'_>),
+    ) {
+        drive(&mut |barys, out| self.evaluate_points(tri, barys, out));
     }
 
     /// [`Surface::evaluate_lattice`] for a caller that reads the normals of the interior points

@@ -285,46 +285,41 @@ pub(crate) fn measured_within(
     within
 }
 
-/// The chord error and the smallest angle in space (radians) of each of `candidates`,
-/// triangles of `pattern`'s points that need not be among its own (`fill.rs` chooses among
-/// them), measured as [`measured_error`] measures the pattern's: the vertices evaluated as it
-/// evaluates them and rounded to `f32`, seven samples each, all evaluated in one call.
-pub(crate) fn candidate_errors(
+/// Calls `choose` once with the vertices of `pattern` on source triangle `tri`, evaluated and
+/// rounded to `f32` as [`measured_error`] evaluates them, and a function giving the chord error
+/// of any triangle of those points (which need not be among the pattern's own: `fill.rs`
+/// chooses among them), measured as [`measured_error`] measures the pattern's, seven samples
+/// each; a triangle's samples are evaluated only when it is asked for, with one set-up of the
+/// source triangle for all of them ([`Surface::evaluate_points_on_demand`]).
+pub(crate) fn with_candidate_errors<R>(
     surface: &dyn Surface,
     tri: usize,
     pattern: &Pattern,
-    candidates: &[[u32; 3]],
     samples: &mut Samples,
-) -> Vec<(f64, f64)> {
+    choose: impl FnOnce(&[DVec3], &mut dyn FnMut([u32; 3]) -> f64) -> R,
+) -> R {
     evaluate_pattern_points(surface, tri, pattern, &mut samples.points);
     let vertices: Vec<DVec3> = samples.points.iter().map(|p| written(p.position)).collect();
-    samples.barys.clear();
-    for t in candidates {
-        let bary = t.map(|p| pattern.bary(p));
-        samples.barys.extend(WEIGHTS.iter().map(|w| {
-            let mut domain = [0.0; 3];
-            for (c, b) in bary.iter().enumerate() {
-                for (d, x) in domain.iter_mut().zip(b) {
-                    *d += w[c] * x;
-                }
-            }
-            domain
-        }));
-    }
-    samples.points.clear();
-    surface.evaluate_points(tri, &samples.barys, &mut samples.points);
-    candidates
-        .iter()
-        .zip(samples.points.chunks_exact(WEIGHTS.len()))
-        .map(|(t, on_surface)| {
-            let flat = t.map(|p| vertices[p as usize]);
-            (sampled_error(flat, on_surface), angle_in_space(flat))
-        })
-        .collect()
+    let Samples { barys, points, .. } = samples;
+    let mut choose = Some(choose);
+    let mut chosen = None;
+    surface.evaluate_points_on_demand(tri, &mut |evaluate| {
+        let mut error_of = |t: [u32; 3]| {
+            barys.clear();
+            barys.extend(samples_in(t.map(|p| pattern.bary(p))));
+            points.clear();
+            evaluate(barys, points);
+            sampled_error(t.map(|p| vertices[p as usize]), points)
+        };
+        if let Some(choose) = choose.take() {
+            chosen = Some(choose(&vertices, &mut error_of));
+        }
+    });
+    chosen.expect("the surface calls `drive` once")
 }
 
 /// The smallest angle of the triangle with corners `p`, in radians (0 if degenerate).
-fn angle_in_space(p: [DVec3; 3]) -> f64 {
+pub(crate) fn angle_in_space(p: [DVec3; 3]) -> f64 {
     (0..3)
         .map(|c| {
             let u = p[(c + 1) % 3] - p[c];
@@ -378,7 +373,11 @@ impl CornerTriangles {
 
 /// The domain points of the [`WEIGHTS`] samples of output triangle `t` of `pattern`.
 fn sample_barys(pattern: &Pattern, t: usize) -> impl Iterator<Item = [f64; 3]> {
-    let bary = pattern.triangles[t].map(|p| pattern.bary(p));
+    samples_in(pattern.triangles[t].map(|p| pattern.bary(p)))
+}
+
+/// The domain points of the [`WEIGHTS`] samples of the domain triangle with corners `bary`.
+fn samples_in(bary: [[f64; 3]; 3]) -> impl Iterator<Item = [f64; 3]> {
     WEIGHTS.into_iter().map(move |w| {
         let mut domain = [0.0; 3];
         for (c, b) in bary.iter().enumerate() {

@@ -394,9 +394,10 @@ fn positions_alone_equal_the_whole_evaluation_bit_for_bit() {
 /// points in runs: the runs, all accepted, must be the points evaluated whole, bit for bit, at
 /// any run length (one, the seven samples of a triangle, more than there are), on split
 /// normals and with some edges at h = 0, through the PN surface's forwarding too; and a run
-/// refused must be the last one handed out.
+/// refused must be the last one handed out. The fill choice asks for points on demand, piece by
+/// piece in an order of its own: each piece must be those points evaluated whole, too.
 #[test]
-fn points_in_runs_equal_the_whole_evaluation_and_stop_when_refused() {
+fn points_in_runs_or_on_demand_equal_the_whole_evaluation_and_runs_stop_when_refused() {
     let check = |s: &dyn Surface, t: usize, barys: &[[f64; 3]]| {
         let mut whole = Vec::new();
         s.evaluate_points(t, barys, &mut whole);
@@ -422,6 +423,34 @@ fn points_in_runs_equal_the_whole_evaluation_and_stop_when_refused() {
                 2.min(barys.len().div_ceil(run)),
                 "triangle {t} run {run}"
             );
+        }
+        // On demand, in pieces of 1, 2, 3 … points asked for from the last piece to the first:
+        // each point as the whole evaluation gives it, whatever was asked for before it.
+        let mut pieces = Vec::new();
+        let mut start = 0;
+        while start < barys.len() {
+            let end = (start + pieces.len() + 1).min(barys.len());
+            pieces.push(start..end);
+            start = end;
+        }
+        let (mut drives, mut on_demand) = (0, vec![None; barys.len()]);
+        s.evaluate_points_on_demand(t, &mut |evaluate| {
+            drives += 1;
+            let mut out = Vec::new();
+            for piece in pieces.iter().rev() {
+                out.clear();
+                evaluate(&barys[piece.clone()], &mut out);
+                assert_eq!(out.len(), piece.len(), "triangle {t} piece {piece:?}");
+                for (x, p) in piece.clone().zip(&out) {
+                    on_demand[x] = Some(*p);
+                }
+            }
+        });
+        assert_eq!(drives, 1, "triangle {t}");
+        for (x, (h, w)) in on_demand.iter().zip(&whole).enumerate() {
+            let h = h.expect("every point asked for");
+            assert_eq!(bits(h.position), bits(w.position), "triangle {t} point {x}");
+            assert_eq!(bits(h.normal), bits(w.normal), "triangle {t} point {x}");
         }
     };
     let random_barys = |rng: &mut Lcg| -> Vec<[f64; 3]> {
