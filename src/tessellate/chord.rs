@@ -140,8 +140,14 @@ fn triangle_errors(
 /// points of the same domain points.
 #[inline]
 fn sampled_error(flat: [DVec3; 3], on_surface: &[SurfacePoint]) -> f64 {
+    sampled_error_with(&WEIGHTS, flat, on_surface)
+}
+
+/// [`sampled_error`] at the samples of `weights` only.
+#[inline]
+fn sampled_error_with(weights: &[[f64; 3]], flat: [DVec3; 3], on_surface: &[SurfacePoint]) -> f64 {
     let mut worst = 0.0f64;
-    for (w, s) in WEIGHTS.iter().zip(on_surface) {
+    for (w, s) in weights.iter().zip(on_surface) {
         let on_flat = w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2];
         worst = worst.max(normal_distance(on_flat, s));
     }
@@ -285,18 +291,31 @@ pub(crate) fn measured_within(
     within
 }
 
+/// What [`with_candidate_errors`] measures among the points of a pattern.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Candidate {
+    /// The chord error of the triangle with these corners, as [`measured_error`] measures an
+    /// output triangle's: seven samples.
+    Triangle([u32; 3]),
+    /// The distance at the midpoint of the side between these two points alone: the sample
+    /// that every triangle with this side measures there (weights ½, ½ and 0), bit for bit
+    /// where the vertices are finite (the third vertex's term is then an exact zero, and the
+    /// two others are summed in the same order), so a triangle's error is at least it.
+    Side(u32, u32),
+}
+
 /// Calls `choose` once with the vertices of `pattern` on source triangle `tri`, evaluated and
-/// rounded to `f32` as [`measured_error`] evaluates them, and a function giving the chord error
-/// of any triangle of those points (which need not be among the pattern's own: `fill.rs`
-/// chooses among them), measured as [`measured_error`] measures the pattern's, seven samples
-/// each; a triangle's samples are evaluated only when it is asked for, with one set-up of the
-/// source triangle for all of them ([`Surface::evaluate_points_on_demand`]).
+/// rounded to `f32` as [`measured_error`] evaluates them, and a function measuring a
+/// [`Candidate`] among those points (the triangles need not be among the pattern's own:
+/// `fill.rs` chooses among them); a candidate's samples are evaluated only when it is asked
+/// for, with one set-up of the source triangle for all of them
+/// ([`Surface::evaluate_points_on_demand`]).
 pub(crate) fn with_candidate_errors<R>(
     surface: &dyn Surface,
     tri: usize,
     pattern: &Pattern,
     samples: &mut Samples,
-    choose: impl FnOnce(&[DVec3], &mut dyn FnMut([u32; 3]) -> f64) -> R,
+    choose: impl FnOnce(&[DVec3], &mut dyn FnMut(Candidate) -> f64) -> R,
 ) -> R {
     evaluate_pattern_points(surface, tri, pattern, &mut samples.points);
     let vertices: Vec<DVec3> = samples.points.iter().map(|p| written(p.position)).collect();
@@ -304,12 +323,22 @@ pub(crate) fn with_candidate_errors<R>(
     let mut choose = Some(choose);
     let mut chosen = None;
     surface.evaluate_points_on_demand(tri, &mut |evaluate| {
-        let mut error_of = |t: [u32; 3]| {
+        let mut error_of = |candidate: Candidate| {
+            // A side as the first two corners of a triangle whose third repeats the second:
+            // the middle sample's weight on it is 0.
+            let (t, weights) = match candidate {
+                Candidate::Triangle(t) => (t, 0..WEIGHTS.len()),
+                Candidate::Side(a, b) => ([a, b, b], 1..2),
+            };
             barys.clear();
-            barys.extend(samples_in(t.map(|p| pattern.bary(p))));
+            barys.extend(
+                samples_in(t.map(|p| pattern.bary(p)))
+                    .skip(weights.start)
+                    .take(weights.len()),
+            );
             points.clear();
             evaluate(barys, points);
-            sampled_error(t.map(|p| vertices[p as usize]), points)
+            sampled_error_with(&WEIGHTS[weights], t.map(|p| vertices[p as usize]), points)
         };
         if let Some(choose) = choose.take() {
             chosen = Some(choose(&vertices, &mut error_of));

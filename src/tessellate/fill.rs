@@ -23,7 +23,7 @@
 //! surface and its own edge samples (the same points its neighbour writes), so it is the same
 //! at any thread count.
 
-use super::chord::{angle_in_space, with_candidate_errors, Samples};
+use super::chord::{angle_in_space, with_candidate_errors, Candidate, Samples};
 use super::kept_patterns;
 use super::transition::{
     min_angle, polygon, triangulation, triangulations, PatternKey, ANGLE_FLOOR,
@@ -60,6 +60,14 @@ pub(crate) fn fill_within(
     let points: Vec<[u32; 3]> = candidates.iter().map(|t| t.map(|v| outer[v])).collect();
     let best_whole =
         with_candidate_errors(surface, tri, &pattern, samples, |vertices, error_of| {
+            // Every triangulation has a triangle on each side of the polygon, measuring at least
+            // the side's midpoint sample: one side over the tolerance leaves none within it.
+            if vertices.iter().all(|v| v.is_finite())
+                && (0..n)
+                    .any(|v| error_of(Candidate::Side(outer[v], outer[(v + 1) % n])) > tolerance)
+            {
+                return None;
+            }
             let angle = |c: usize| angle_in_space(points[c].map(|p| vertices[p as usize]));
             // best[lo·n + hi]: the largest smallest angle in space of sub-polygon lo..=hi's
             // triangulations within the tolerance, and the first such triangulation's index. A
@@ -84,7 +92,7 @@ pub(crate) fn fill_within(
                             {
                                 let angle = angle(c).min(left).min(right);
                                 if found.is_none_or(|(a, _)| angle > a)
-                                    && error_of(points[c]) <= tolerance
+                                    && error_of(Candidate::Triangle(points[c])) <= tolerance
                                 {
                                     found = Some((angle, offset + li * right_count + ri));
                                 }
