@@ -932,26 +932,6 @@ impl Surface for G2Surface<'_> {
         PartEvaluation::run(self, tri, &[(level, part)], out);
     }
 
-    /// One set-up for every run, each run's points evaluated only once the runs before it
-    /// were accepted.
-    fn evaluate_points_while(
-        &self,
-        tri: usize,
-        barys: &[[f64; 3]],
-        run: usize,
-        out: &mut Vec<SurfacePoint>,
-        each: &mut dyn FnMut(&[SurfacePoint]) -> bool,
-    ) {
-        let mut points = PointEvaluation::new(self, tri);
-        for run in barys.chunks(run.max(1)) {
-            out.clear();
-            out.extend(run.iter().map(|&bary| points.at(self, bary)));
-            if !each(out) {
-                return;
-            }
-        }
-    }
-
     /// One set-up for every call.
     fn evaluate_points_on_demand(
         &self,
@@ -1319,17 +1299,6 @@ impl Surface for PnSurface<'_> {
 
     fn evaluate_points(&self, tri: usize, barys: &[[f64; 3]], out: &mut Vec<SurfacePoint>) {
         self.0.evaluate_points(tri, barys, out)
-    }
-
-    fn evaluate_points_while(
-        &self,
-        tri: usize,
-        barys: &[[f64; 3]],
-        run: usize,
-        out: &mut Vec<SurfacePoint>,
-        each: &mut dyn FnMut(&[SurfacePoint]) -> bool,
-    ) {
-        self.0.evaluate_points_while(tri, barys, run, out, each)
     }
 
     fn evaluate_points_on_demand(

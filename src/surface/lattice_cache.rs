@@ -22,14 +22,19 @@ use std::sync::{Arc, OnceLock, RwLock};
 /// interior and its three edges for four width triples.
 pub const HOT_ENTRIES: usize = 16;
 
-/// Weights per key, at most `max` of them. Past the bound nothing is built: the caller decides
-/// what to do instead (compute its points directly, or build an entry it does not keep), which
-/// gives the same values, so the bound affects speed only.
+/// Weights per key, at most `max` of them, or entries weighing at most `max` in all
+/// ([`LatticeCache::weighed`]). Past the bound nothing is built: the caller decides what to do
+/// instead (compute its points directly, or build an entry it does not keep), which gives the
+/// same values, so the bound affects speed only.
 pub struct LatticeCache<K, P> {
     /// The first entries built, in the order they were built (filled slots form a prefix).
     hot: HotSlots<K, P>,
-    map: RwLock<HashMap<K, Arc<P>>>,
+    /// The entries and their total weight.
+    map: RwLock<(HashMap<K, Arc<P>>, usize)>,
     max: usize,
+    /// What an entry counts against `max`: 1 each, or, for entries whose sizes differ many
+    /// times over (transition patterns), their bytes.
+    weigh: fn(&P) -> usize,
 }
 
 /// The hot slots on cache lines of their own: they are read by every thread for every triangle,
@@ -60,10 +65,16 @@ impl<P> Deref for Entry<'_, P> {
 impl<K: Hash + Eq + Clone, P> LatticeCache<K, P> {
     /// An empty store that keeps at most `max` entries.
     pub fn new(max: usize) -> Self {
+        LatticeCache::weighed(max, |_| 1)
+    }
+
+    /// An empty store that keeps entries while their total `weigh` is at most `max`.
+    pub fn weighed(max: usize, weigh: fn(&P) -> usize) -> Self {
         LatticeCache {
             hot: HotSlots(std::array::from_fn(|_| OnceLock::new())),
-            map: RwLock::new(HashMap::new()),
+            map: RwLock::new((HashMap::new(), 0)),
             max,
+            weigh,
         }
     }
 
@@ -77,19 +88,28 @@ impl<K: Hash + Eq + Clone, P> LatticeCache<K, P> {
                 None => break,
             }
         }
-        if let Some(p) = self.map.read().expect("lattice cache lock").get(&key) {
-            return Some(Entry::Shared(Arc::clone(p)));
-        }
-        if self.map.read().expect("lattice cache lock").len() >= self.max {
-            return None;
+        {
+            let map = self.map.read().expect("lattice cache lock");
+            if let Some(p) = map.0.get(&key) {
+                return Some(Entry::Shared(Arc::clone(p)));
+            }
+            if map.1 >= self.max {
+                return None;
+            }
         }
         let built = Arc::new(build());
+        let weight = (self.weigh)(&built);
         let mut map = self.map.write().expect("lattice cache lock");
-        if map.len() >= self.max {
+        // Another thread may have built the same entry meanwhile: equal values, keep one.
+        if let Some(p) = map.0.get(&key) {
+            return Some(Entry::Shared(Arc::clone(p)));
+        }
+        if map.1 + weight > self.max {
             return Some(Entry::Shared(built));
         }
-        // Another thread may have built the same entry meanwhile: equal values, keep one.
-        let kept = Arc::clone(map.entry(key.clone()).or_insert(built));
+        map.1 += weight;
+        map.0.insert(key.clone(), Arc::clone(&built));
+        let kept = built;
         // Slots are tried in order, so the filled ones stay a prefix.
         for slot in &self.hot.0 {
             if slot.get().is_some_and(|(k, _)| *k == key)
@@ -105,13 +125,13 @@ impl<K: Hash + Eq + Clone, P> LatticeCache<K, P> {
 /// A copy starts empty: entries are rebuilt on demand, with the same values.
 impl<K: Hash + Eq + Clone, P> Clone for LatticeCache<K, P> {
     fn clone(&self) -> Self {
-        LatticeCache::new(self.max)
+        LatticeCache::weighed(self.max, self.weigh)
     }
 }
 
 impl<K, P> fmt::Debug for LatticeCache<K, P> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let len = self.map.read().map(|m| m.len()).unwrap_or(0);
+        let len = self.map.read().map(|m| m.0.len()).unwrap_or(0);
         f.debug_struct("LatticeCache")
             .field("entries", &len)
             .field("max", &self.max)
@@ -142,6 +162,22 @@ mod tests {
             cache.get_or_build(2, || 99),
             Some(Entry::Borrowed(&20))
         ));
+    }
+
+    /// A weighed store keeps entries while their weights fit, gives one that does not fit to
+    /// its caller without keeping it, and builds nothing once the weights reach the bound.
+    #[test]
+    fn a_weighed_store_keeps_entries_while_their_weights_fit() {
+        let cache: LatticeCache<u32, u32> = LatticeCache::weighed(10, |&v| v as usize);
+        assert_eq!(cache.get_or_build(1, || 4).as_deref(), Some(&4));
+        // 4 + 7 > 10: given, not kept.
+        assert_eq!(cache.get_or_build(2, || 7).as_deref(), Some(&7));
+        assert_eq!(cache.get_or_build(2, || 5).as_deref(), Some(&5));
+        // 4 + 5 + 1 = 10: kept, and the store is full.
+        assert_eq!(cache.get_or_build(3, || 1).as_deref(), Some(&1));
+        assert_eq!(cache.get_or_build(2, || 99).as_deref(), Some(&5));
+        assert!(cache.get_or_build(4, || 0).is_none());
+        assert_eq!(cache.get_or_build(1, || 99).as_deref(), Some(&4));
     }
 
     #[test]

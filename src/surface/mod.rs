@@ -153,34 +153,12 @@ pub trait Surface: Sync {
         out.extend(barys.iter().map(|&b| self.evaluate(tri, b)));
     }
 
-    /// [`Surface::evaluate_points`] handed out `run` points at a time (the last run may be
-    /// shorter): `each` is called with every run in order, as `out` holds it (cleared before
-    /// each run), and no point past a run it refuses (returns `false` for) is evaluated. The
-    /// same points, bit for bit. A check that can fail on any output triangle's samples
-    /// (`tessellate::chord`'s early-exit check) then evaluates only as far as the first that
-    /// fails. Here each run is one [`Surface::evaluate_points`] call; a surface that sets a
-    /// triangle up per call should set it up once for all the runs, as G2Surface does.
-    fn evaluate_points_while(
-        &self,
-        tri: usize,
-        barys: &[[f64; 3]],
-        run: usize,
-        out: &mut Vec<SurfacePoint>,
-        each: &mut dyn FnMut(&[SurfacePoint]) -> bool,
-    ) {
-        for run in barys.chunks(run.max(1)) {
-            out.clear();
-            self.evaluate_points(tri, run, out);
-            if !each(out) {
-                return;
-            }
-        }
-    }
-
     /// Calls `drive` once with a function that appends the points of triangle `tri` at any
     /// barycentrics to a buffer, each equal to [`Surface::evaluate_points`]'s bit for bit, for a
-    /// caller that decides which points it needs next from those it has (the fill choice of
-    /// `tessellate::fill` measures a candidate triangle only where it could change the choice).
+    /// caller that decides which points it needs next from those it has: the early-exit check
+    /// of `tessellate::chord` stops at the first output triangle over the tolerance, and the
+    /// fill choice of `tessellate::fill` measures a candidate triangle only where it could
+    /// change the choice.
     /// Here each call is one [`Surface::evaluate_points`] call; a surface that sets a triangle
     /// up per call should set it up once for all of them, as G2Surface does.
     fn evaluate_points_on_demand(

@@ -14,7 +14,6 @@
 //! once and shared (`transition.rs`).
 
 use std::ops::Range;
-use std::sync::Arc;
 
 use rayon::prelude::*;
 
@@ -22,7 +21,7 @@ use super::blocks::{self, Block};
 use super::counts::SegmentCounts;
 use super::emit;
 use super::held::{self, HeldInteriors};
-use super::kept_patterns;
+use super::kept_patterns::{self, Kept};
 use super::layout::GroupLayout;
 use super::transition::{Pattern, PatternKey};
 use super::{DenseMesh, VertexSource, BLOCK_TRIANGLES};
@@ -75,7 +74,7 @@ pub fn tessellate_with_held(
     let mut distinct = keys.clone();
     distinct.par_sort_unstable();
     distinct.dedup();
-    let patterns: Vec<Arc<Pattern>> = distinct
+    let patterns: Vec<Kept<Pattern>> = distinct
         .par_iter()
         .map(|&k| kept_patterns::pattern(k))
         .collect();
@@ -105,7 +104,7 @@ struct Shared<'a> {
     surface: &'a dyn Surface,
     counts: &'a SegmentCounts,
     held: &'a HeldInteriors,
-    patterns: &'a [Arc<Pattern>],
+    patterns: &'a [Kept<Pattern>],
     pattern_of: &'a [u32],
 }
 

@@ -31,14 +31,13 @@
 
 use std::collections::HashMap;
 use std::ops::Range;
-use std::sync::Arc;
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::counts::SegmentCounts;
 use super::estimate::PatternError;
-use super::kept_patterns;
+use super::kept_patterns::{self, Kept};
 use super::transition::{Pattern, PatternKey};
 use super::DenseMesh;
 use crate::surface::{LatticePart, Surface, SurfacePoint};
@@ -68,7 +67,7 @@ pub fn chord_error(
     dense: &DenseMesh,
 ) -> f64 {
     let keys: Vec<PatternKey> = group.clone().map(|t| counts.key(topo, t)).collect();
-    let mut patterns: HashMap<PatternKey, Arc<Pattern>> = HashMap::new();
+    let mut patterns: HashMap<PatternKey, Kept<Pattern>> = HashMap::new();
     let mut first_index = Vec::with_capacity(keys.len());
     let mut total = 0usize;
     for &key in &keys {
@@ -267,26 +266,22 @@ pub(crate) fn measured_within(
     samples: &mut Samples,
 ) -> bool {
     let vertices = written_vertices(surface, tri, pattern, samples);
-    samples.barys.clear();
-    for t in 0..pattern.triangles.len() {
-        samples.barys.extend(sample_barys(pattern, t));
-    }
-    let mut t = 0;
+    let Samples { barys, points, .. } = samples;
     let mut within = tolerance >= 0.0;
-    surface.evaluate_points_while(
-        tri,
-        &samples.barys,
-        WEIGHTS.len(),
-        &mut samples.points,
-        &mut |on_surface| {
-            let flat = pattern.triangles[t].map(|p| vertices[p as usize]);
-            t += 1;
-            if sampled_error(flat, on_surface) > tolerance {
+    surface.evaluate_points_on_demand(tri, &mut |evaluate| {
+        for (t, corners) in pattern.triangles.iter().enumerate() {
+            barys.clear();
+            barys.extend(sample_barys(pattern, t));
+            points.clear();
+            evaluate(barys, points);
+            if sampled_error(corners.map(|p| vertices[p as usize]), points) > tolerance {
                 within = false;
             }
-            within
-        },
-    );
+            if !within {
+                return;
+            }
+        }
+    });
     samples.vertices = vertices;
     within
 }
@@ -514,7 +509,7 @@ mod tests {
     }
 
     /// [`Field`] counting the points it evaluates, so that a check that stops early is seen to
-    /// stop (through the trait's own runs of points).
+    /// stop (through the trait's own evaluation on demand).
     struct CountingField(std::sync::atomic::AtomicUsize);
 
     impl Surface for CountingField {

@@ -24,14 +24,13 @@
 //! touches has changed. The rounds stop when no step is left to try, or after [`ROUNDS`].
 
 use std::collections::HashMap;
-use std::sync::Arc;
 
 use rayon::prelude::*;
 
 use super::chord::{measured_within, Samples};
 use super::counts::{inner_floor, SegmentCounts};
 use super::fill::fill_within;
-use super::kept_patterns;
+use super::kept_patterns::{self, Kept};
 use super::transition::{Pattern, PatternKey};
 use crate::surface::Surface;
 use crate::topology::{EdgeId, Topology};
@@ -65,7 +64,7 @@ pub(crate) fn coarsen(
     let mut version = vec![0u64; tris];
     let mut failed_edge: Vec<Option<u64>> = vec![None; counts.edges.len()];
     let mut failed_inner: Vec<Option<u64>> = vec![None; tris];
-    let mut built: HashMap<PatternKey, Arc<Pattern>> = HashMap::new();
+    let mut built: HashMap<PatternKey, Kept<Pattern>> = HashMap::new();
     let mut busy = vec![false; tris];
     for _ in 0..ROUNDS {
         busy.iter_mut().for_each(|b| *b = false);
@@ -148,7 +147,7 @@ pub(crate) fn coarsen(
             .collect();
         fresh.sort_unstable();
         fresh.dedup();
-        let patterns: Vec<Arc<Pattern>> = fresh
+        let patterns: Vec<Kept<Pattern>> = fresh
             .par_iter()
             .map(|&k| kept_patterns::pattern(k))
             .collect();

@@ -8,15 +8,16 @@
 //! its own: the 10 meshes of the PalmTree sample at a relative tolerance of 2e-4 built 17,631
 //! patterns and as many models for 1,769 distinct keys, 42% of the whole run's instructions.
 //!
-//! The stores are bounded by bytes, first built, first kept: past the bound a pattern is built
-//! for its caller and not kept, which costs time, never a difference in values.
+//! They are kept in the stores the surfaces keep their lattice weights in ([`LatticeCache`]),
+//! bounded by bytes rather than by count, as a pattern of inner level 64 takes thirty times
+//! what one of level 12 does: first built, first kept, and past the bound a pattern is built for
+//! its caller and not kept, which costs time, never a difference in values.
 
-use std::collections::HashMap;
-use std::hash::Hash;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, OnceLock};
 
 use super::estimate::PatternModel;
 use super::transition::{Pattern, PatternKey};
+use crate::surface::lattice_cache::{Entry, LatticeCache};
 
 /// Most bytes of patterns kept: about 60 kB for a pattern of inner level 64, 2 kB at 12.
 const PATTERN_BYTES: usize = 16 << 20;
@@ -24,72 +25,28 @@ const PATTERN_BYTES: usize = 16 << 20;
 /// Most bytes of models kept: about 80 bytes per boundary sample, 45 kB at inner level 64.
 const MODEL_BYTES: usize = 16 << 20;
 
+/// A kept pattern or model, or one built for its caller alone.
+pub(crate) type Kept<P> = Entry<'static, P>;
+
 /// The pattern of `key`, kept for every later caller while the store has room.
-pub(crate) fn pattern(key: PatternKey) -> Arc<Pattern> {
-    static PATTERNS: OnceLock<Store<PatternKey, Pattern>> = OnceLock::new();
+pub(crate) fn pattern(key: PatternKey) -> Kept<Pattern> {
+    static PATTERNS: OnceLock<LatticeCache<PatternKey, Pattern>> = OnceLock::new();
+    let build = || Pattern::new(key);
     PATTERNS
-        .get_or_init(|| Store::new(PATTERN_BYTES))
-        .get_or_build(key, || {
-            let pattern = Pattern::new(key);
-            let bytes = pattern.bytes();
-            (pattern, bytes)
-        })
+        .get_or_init(|| LatticeCache::weighed(PATTERN_BYTES, Pattern::bytes))
+        .get_or_build(key, build)
+        .unwrap_or_else(|| Entry::Shared(Arc::new(build())))
 }
 
 /// The model of `key`'s pattern over a level-`level` lattice ([`PatternModel::new`]), kept as
 /// [`pattern`] keeps patterns.
-pub(crate) fn model(key: PatternKey, level: u32) -> Arc<PatternModel> {
-    static MODELS: OnceLock<Store<(PatternKey, u32), PatternModel>> = OnceLock::new();
+pub(crate) fn model(key: PatternKey, level: u32) -> Kept<PatternModel> {
+    static MODELS: OnceLock<LatticeCache<(PatternKey, u32), PatternModel>> = OnceLock::new();
+    let build = || PatternModel::new(&pattern(key), level);
     MODELS
-        .get_or_init(|| Store::new(MODEL_BYTES))
-        .get_or_build((key, level), || {
-            let model = PatternModel::new(&pattern(key), level);
-            let bytes = model.bytes();
-            (model, bytes)
-        })
-}
-
-/// Values by key, at most `limit` bytes of them.
-struct Store<K, V> {
-    kept: Mutex<(HashMap<K, Arc<V>>, usize)>,
-    limit: usize,
-}
-
-impl<K: Hash + Eq + Copy, V> Store<K, V> {
-    fn new(limit: usize) -> Store<K, V> {
-        Store {
-            kept: Mutex::new((HashMap::new(), 0)),
-            limit,
-        }
-    }
-
-    /// The value of `key`: the kept one, or `build`'s (the value and its size in bytes),
-    /// kept if it fits. Built outside the lock, so threads building different keys do not
-    /// wait for each other; two building the same key at once both build it, and the first
-    /// to finish is kept (the values are equal).
-    fn get_or_build(&self, key: K, build: impl FnOnce() -> (V, usize)) -> Arc<V> {
-        if let Some(value) = self.lock().0.get(&key) {
-            return Arc::clone(value);
-        }
-        let (value, bytes) = build();
-        let value = Arc::new(value);
-        let mut kept = self.lock();
-        if let Some(first) = kept.0.get(&key) {
-            return Arc::clone(first);
-        }
-        if kept.1 + bytes <= self.limit {
-            kept.1 += bytes;
-            kept.0.insert(key, Arc::clone(&value));
-        }
-        value
-    }
-
-    /// The kept values; a poisoned lock still holds whole entries (they are inserted whole).
-    fn lock(&self) -> std::sync::MutexGuard<'_, (HashMap<K, Arc<V>>, usize)> {
-        self.kept
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-    }
+        .get_or_init(|| LatticeCache::weighed(MODEL_BYTES, PatternModel::bytes))
+        .get_or_build((key, level), build)
+        .unwrap_or_else(|| Entry::Shared(Arc::new(build())))
 }
 
 #[cfg(test)]
@@ -97,7 +54,7 @@ mod tests {
     use super::*;
 
     /// A kept pattern or model is the one built for its key, whichever key was asked for
-    /// before it, and a store past its bound still gives every caller its value.
+    /// before it, the first time and every time after.
     #[test]
     fn kept_patterns_and_models_are_those_of_their_keys() {
         let keys = [
@@ -116,24 +73,13 @@ mod tests {
                 for level in [6, key.inner.max(3), 2 * key.inner] {
                     let kept = model(key, level);
                     let built = PatternModel::new(&built, level);
-                    assert_eq!(format!("{kept:?}"), format!("{built:?}"), "{key:?} {level}");
+                    assert_eq!(
+                        format!("{:?}", &*kept),
+                        format!("{built:?}"),
+                        "{key:?} {level}"
+                    );
                 }
             }
         }
-        let full: Store<u32, u32> = Store::new(8);
-        for x in 0..4 {
-            assert_eq!(*full.get_or_build(x, || (10 * x, 4)), 10 * x);
-        }
-        assert_eq!(full.lock().0.len(), 2, "kept past the bound");
-        assert_eq!(
-            *full.get_or_build(3, || (99, 4)),
-            99,
-            "not kept: built again"
-        );
-        assert_eq!(
-            *full.get_or_build(1, || (99, 4)),
-            10,
-            "kept: not built again"
-        );
     }
 }

@@ -390,40 +390,15 @@ fn positions_alone_equal_the_whole_evaluation_bit_for_bit() {
     });
 }
 
-/// The check that stops at the first output triangle over its tolerance asks for a triangle's
-/// points in runs: the runs, all accepted, must be the points evaluated whole, bit for bit, at
-/// any run length (one, the seven samples of a triangle, more than there are), on split
-/// normals and with some edges at h = 0, through the PN surface's forwarding too; and a run
-/// refused must be the last one handed out. The fill choice asks for points on demand, piece by
-/// piece in an order of its own: each piece must be those points evaluated whole, too.
+/// The early-exit chord check and the fill choice ask for a triangle's points on demand, piece
+/// by piece in an order of their own: each piece must be those points evaluated whole, bit for
+/// bit, whatever was asked for before it, on split normals and with some edges at h = 0,
+/// through the PN surface's forwarding too, with one call of `drive`.
 #[test]
-fn points_in_runs_or_on_demand_equal_the_whole_evaluation_and_runs_stop_when_refused() {
+fn points_on_demand_equal_the_whole_evaluation() {
     let check = |s: &dyn Surface, t: usize, barys: &[[f64; 3]]| {
         let mut whole = Vec::new();
         s.evaluate_points(t, barys, &mut whole);
-        for run in [1, 7, barys.len() + 3] {
-            let (mut handed, mut scratch) = (Vec::new(), Vec::new());
-            s.evaluate_points_while(t, barys, run, &mut scratch, &mut |points| {
-                assert!(points.len() <= run, "triangle {t} run {run}");
-                handed.extend_from_slice(points);
-                true
-            });
-            assert_eq!(handed.len(), whole.len(), "triangle {t} run {run}");
-            for (x, (h, w)) in handed.iter().zip(&whole).enumerate() {
-                assert_eq!(bits(h.position), bits(w.position), "triangle {t} point {x}");
-                assert_eq!(bits(h.normal), bits(w.normal), "triangle {t} point {x}");
-            }
-            let mut calls = 0;
-            s.evaluate_points_while(t, barys, run, &mut scratch, &mut |_| {
-                calls += 1;
-                calls < 2
-            });
-            assert_eq!(
-                calls,
-                2.min(barys.len().div_ceil(run)),
-                "triangle {t} run {run}"
-            );
-        }
         // On demand, in pieces of 1, 2, 3 … points asked for from the last piece to the first:
         // each point as the whole evaluation gives it, whatever was asked for before it.
         let mut pieces = Vec::new();
