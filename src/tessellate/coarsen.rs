@@ -27,7 +27,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use super::chord::{measured_within, Samples};
+use super::chord::{measured_within, written_vertices, Samples};
 use super::counts::{inner_floor, SegmentCounts};
 use super::fill::fill_within;
 use super::kept_patterns::{self, Kept};
@@ -152,21 +152,42 @@ pub(crate) fn coarsen(
             .map(|&k| kept_patterns::pattern(k))
             .collect();
         built.extend(fresh.into_iter().zip(patterns));
+        // Per checked triangle, its edge whose count its step lowers, if it is an edge's: the
+        // check measures that edge's sides first.
+        let mut lowered: Vec<Option<usize>> = vec![None; checked.len()];
+        for &step in &steps {
+            if let Step::Edge(e) = step {
+                for t in touched(step) {
+                    let at = checked.binary_search(&t).expect("checked");
+                    lowered[at] = topo.tri_edges[t].iter().position(|x| x.0 == e);
+                }
+            }
+        }
         // Per checked triangle, whether it passes and with which fill (0 unless the default
-        // fill fails and one chosen by measured error passes).
+        // fill fails and one chosen by measured error passes); its points evaluated once for
+        // every fill tried.
         let passes: Vec<Option<u16>> = checked
             .par_iter()
-            .map_init(Samples::default, |samples, &t| {
+            .zip(&lowered)
+            .map_init(Samples::default, |samples, (&t, &lowered)| {
                 let key = counts.key(topo, t);
-                if measured_within(surface, t, &built[&key], tolerance, samples) {
-                    return Some(0);
-                }
-                if key.inner >= 3 {
-                    return None;
-                }
-                let fill = fill_within(surface, t, key, tolerance, samples)?;
-                let filled = kept_patterns::pattern(PatternKey { fill, ..key });
-                measured_within(surface, t, &filled, tolerance, samples).then_some(fill)
+                let pattern = &built[&key];
+                let vertices = written_vertices(surface, t, pattern, samples);
+                let within = |pattern: &Pattern, lowered, samples: &mut Samples| {
+                    measured_within(surface, t, pattern, &vertices, tolerance, lowered, samples)
+                };
+                let pass = if within(pattern, lowered, samples) {
+                    Some(0)
+                } else if key.inner >= 3 {
+                    None
+                } else {
+                    fill_within(surface, t, key, &vertices, tolerance, samples).filter(|&fill| {
+                        let filled = kept_patterns::pattern(PatternKey { fill, ..key });
+                        within(&filled, None, samples)
+                    })
+                };
+                samples.give_back(vertices);
+                pass
             })
             .collect();
         let passes_at = |t: usize| passes[checked.binary_search(&t).expect("checked")];

@@ -17,11 +17,14 @@
 //! so each sub-polygon's best is best wherever it is used), a candidate triangle measured at
 //! most once, and only where its error could change a sub-polygon's best (at most 84
 //! candidates, for the 9 points of edges 3, 3, 3; on the Duck a quarter of them are measured,
-//! which gives the choice that measuring all of them gives). Its index in
+//! which gives the choice that measuring all of them gives), and a side's midpoint sample once
+//! for all the candidates that share that side. Its index in
 //! [`triangulation`]'s order is the pattern key's `fill`, so the pattern is rebuilt from the
 //! key alone wherever it is used. The choice is per source triangle and reads only its own
 //! surface and its own edge samples (the same points its neighbour writes), so it is the same
 //! at any thread count.
+
+use glam::DVec3;
 
 use super::chord::{angle_in_space, with_candidate_errors, Candidate, Samples};
 use super::kept_patterns;
@@ -32,11 +35,13 @@ use crate::surface::Surface;
 
 /// The fill of `key` (its inner level at most 2) whose triangles on source triangle `tri` all
 /// measure within `tolerance` and keep the floor, with the largest smallest angle in space;
-/// `None` when there is none.
+/// `None` when there is none. `vertices` are the points of `key`'s counts as
+/// [`written_vertices`](super::chord::written_vertices) gives them (the same for every fill).
 pub(crate) fn fill_within(
     surface: &dyn Surface,
     tri: usize,
     key: PatternKey,
+    vertices: &[DVec3],
     tolerance: f64,
     samples: &mut Samples,
 ) -> Option<u16> {
@@ -58,8 +63,13 @@ pub(crate) fn fill_within(
         }
     }
     let points: Vec<[u32; 3]> = candidates.iter().map(|t| t.map(|v| outer[v])).collect();
-    let best_whole =
-        with_candidate_errors(surface, tri, &pattern, samples, |vertices, error_of| {
+    let best_whole = with_candidate_errors(
+        surface,
+        tri,
+        &pattern,
+        vertices,
+        samples,
+        |vertices, error_of| {
             // Every triangulation has a triangle on each side of the polygon, measuring at least
             // the side's midpoint sample: one side over the tolerance leaves none within it.
             if vertices.iter().all(|v| v.is_finite())
@@ -104,7 +114,8 @@ pub(crate) fn fill_within(
                 }
             }
             best[n - 1]
-        });
+        },
+    );
     let (_, index) = best_whole?;
     debug_assert!(triangulation(n, index).all(|t| slot[(t[0] * n + t[1]) * n + t[2]] != usize::MAX));
     Some(u16::try_from(index + 1).expect("at most 429 triangulations of 9 points"))
@@ -114,7 +125,7 @@ pub(crate) fn fill_within(
 mod tests {
     use super::*;
     use crate::surface::SurfacePoint;
-    use crate::tessellate::chord::measured_error;
+    use crate::tessellate::chord::{measured_error, written_vertices};
     use crate::tessellate::transition::Pattern;
     use glam::DVec3;
 
@@ -185,7 +196,8 @@ mod tests {
                         .filter(|t| t.1 <= tolerance)
                         .map(|t| t.2)
                         .fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.max(b))));
-                    let fill = fill_within(&surface, 0, key, tolerance, &mut samples);
+                    let vertices = written_vertices(&surface, 0, &Pattern::new(key), &mut samples);
+                    let fill = fill_within(&surface, 0, key, &vertices, tolerance, &mut samples);
                     let at = format!("{edges:?} turn {turn} tolerance {tolerance}");
                     match (best, fill) {
                         (None, None) => none += 1,
@@ -237,7 +249,9 @@ mod tests {
                 .fold(f64::MAX, f64::min);
             let tolerance = 1.01 * best;
             default_failed |= worst(default_error) > tolerance;
-            let fill = fill_within(&surface, 0, key, tolerance, &mut samples).expect("a fill");
+            let vertices = written_vertices(&surface, 0, &default, &mut samples);
+            let fill =
+                fill_within(&surface, 0, key, &vertices, tolerance, &mut samples).expect("a fill");
             let pattern = Pattern::new(PatternKey { fill, ..key });
             assert!(
                 measured_error(&surface, 0, &pattern, &mut samples).within(tolerance),

@@ -30,6 +30,8 @@
 //! It deliberately knows no mesh and no surface: patterns depend on the counts alone and are
 //! built once per distinct `(counts, M)` and shared.
 
+use std::sync::OnceLock;
+
 use super::lattice_edges::SampleKind;
 use super::plan::LatticePlan;
 
@@ -89,6 +91,25 @@ pub(crate) struct Pattern {
     pub interior_by_rank: Vec<u32>,
     /// Triangles as point indices, wound like the source triangle.
     pub triangles: Vec<[u32; 3]>,
+    /// [`Pattern::sides`], found on first use: only the checks that measure every output
+    /// triangle ask for it, on patterns of a few hundred triangles, while sorting the sides of
+    /// every pattern built took more than building it.
+    sides: OnceLock<Sides>,
+}
+
+/// How the output triangles of a [`Pattern`] share their sides: per triangle, bit `k` for its
+/// side from corner `k` to corner `k + 1` (mod 3).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Sides {
+    /// The side is also a side of an earlier triangle: a check measuring the triangles in
+    /// order has measured its midpoint sample already (`chord.rs`).
+    pub earlier: Vec<u8>,
+    /// Per side `3t + k` marked in [`Sides::earlier`], the first triangle's side `3t' + k'` it
+    /// is; `u32::MAX` for the others.
+    pub first: Vec<u32>,
+    /// Per edge of the source triangle, the sides along it (no other triangle's), as
+    /// (triangle, side).
+    pub along: [Vec<(u32, u8)>; 3],
 }
 
 impl Pattern {
@@ -98,6 +119,12 @@ impl Pattern {
             + std::mem::size_of_val(&self.lattice[..])
             + std::mem::size_of_val(&self.interior_by_rank[..])
             + std::mem::size_of_val(&self.triangles[..])
+            + 14 * self.triangles.len() // its sides' uses, once found
+    }
+
+    /// How the output triangles share their sides.
+    pub fn sides(&self) -> &Sides {
+        self.sides.get_or_init(|| Sides::of(self))
     }
 
     /// Builds the pattern of `key`.
@@ -135,6 +162,7 @@ impl Pattern {
             interior_start,
             interior_by_rank: Vec::new(),
             triangles: Vec::new(),
+            sides: OnceLock::new(),
         };
         if edges == [m; 3] && key.fill == 0 {
             pattern.triangles = uniform_triangles(&pattern, m);
@@ -200,6 +228,50 @@ impl Pattern {
             SampleKind::Interior { index } => self.interior_start + index as u32,
             other => unreachable!("({i}, {j}) is {other:?}"),
         }
+    }
+}
+
+impl Sides {
+    /// The sides of `pattern`'s triangles: every side once with the triangle and corner it
+    /// starts at, sorted, so that equal sides are neighbours, the earliest triangle's first.
+    fn of(pattern: &Pattern) -> Sides {
+        let triangles = &pattern.triangles;
+        let mut sides: Vec<([u32; 2], u32)> = (0..triangles.len() * 3)
+            .map(|tk| {
+                let corners = triangles[tk / 3];
+                let (a, b) = (corners[tk % 3], corners[(tk + 1) % 3]);
+                ([a.min(b), a.max(b)], tk as u32)
+            })
+            .collect();
+        sides.sort_unstable();
+        let mut uses = Sides {
+            earlier: vec![0; triangles.len()],
+            first: vec![u32::MAX; 3 * triangles.len()],
+            along: Default::default(),
+        };
+        let mut run_start = 0;
+        for (i, &(side, tk)) in sides.iter().enumerate() {
+            let (t, k) = (tk / 3, (tk % 3) as u8);
+            let before = i > 0 && sides[i - 1].0 == side;
+            let after = sides.get(i + 1).is_some_and(|next| next.0 == side);
+            if !before {
+                run_start = i;
+            }
+            if before {
+                uses.earlier[t as usize] |= 1 << k;
+                uses.first[tk as usize] = sides[run_start].1;
+            } else if !after {
+                // On the edge where both ends have no weight on its opposite corner.
+                let [a, b] = side.map(|p| pattern.bary(p));
+                if let Some(edge) = (0..3).find(|&e| a[e] == 0.0 && b[e] == 0.0) {
+                    uses.along[edge].push((t, k));
+                }
+            }
+        }
+        for along in &mut uses.along {
+            along.sort_unstable();
+        }
+        uses
     }
 }
 
@@ -419,15 +491,31 @@ pub(crate) fn polygon(pattern: &Pattern) -> Vec<u32> {
     outer
 }
 
+/// The Catalan numbers `C(0)` to `C(19)`, the last that fits a `u32`: `C(k + 1) = Σ C(i)·C(k − i)`.
+const CATALAN: [u32; 20] = {
+    let mut c = [1u32; 20];
+    let mut k = 0;
+    while k + 1 < c.len() {
+        let mut sum = 0;
+        let mut i = 0;
+        while i <= k {
+            sum += c[i] * c[k - i];
+            i += 1;
+        }
+        c[k + 1] = sum;
+        k += 1;
+    }
+    c
+};
+
 /// Number of triangulations of a convex polygon of `n` points: the Catalan number
 /// `C(n − 2)` (1 for a triangle, 429 for the 9 points of edges 3, 3, 3 around no interior).
+/// A table, as the fill search (`fill.rs`) asks for it twice per candidate apex.
+///
+/// # Panics
+/// Above 21 points, whose count does not fit a `u32` (a fill has at most 9).
 pub(crate) fn triangulations(n: usize) -> u32 {
-    // C(k + 1) = Σ C(i)·C(k − i).
-    let mut catalan = vec![1u32];
-    for k in 0..n.saturating_sub(2) {
-        catalan.push((0..=k).map(|i| catalan[i] * catalan[k - i]).sum());
-    }
-    catalan[n.saturating_sub(2)]
+    CATALAN[n.saturating_sub(2)]
 }
 
 /// Triangulation `index` of the convex polygon of points `0..n`, counter-clockwise, as
@@ -508,6 +596,53 @@ mod tests {
             "{key:?}: every point used"
         );
         worst
+    }
+
+    /// A pattern's sides: each inside side marked on every triangle after the first that has
+    /// it, each side along an edge listed under that edge and nowhere marked, and an edge of
+    /// `e` segments listing `e` of them, whatever the counts and fill.
+    #[test]
+    fn the_sides_are_found_shared_or_along_their_edge() {
+        for (edges, inner, fill) in [
+            ([4, 4, 4], 4, 0),
+            ([5, 3, 7], 6, 0),
+            ([1, 2, 3], 2, 0),
+            ([3, 3, 3], 2, 17),
+            ([2, 1, 1], 1, 0),
+        ] {
+            let pattern = Pattern::new(PatternKey { edges, inner, fill });
+            let sides = pattern.sides();
+            let side = |t: usize, k: usize| {
+                let c = pattern.triangles[t];
+                let (a, b) = (c[k], c[(k + 1) % 3]);
+                [a.min(b), a.max(b)]
+            };
+            let what = format!("{edges:?} {inner} {fill}");
+            for t in 0..pattern.triangles.len() {
+                for k in 0..3 {
+                    let before = (0..t).any(|u| (0..3).any(|l| side(u, l) == side(t, k)));
+                    let shared = sides.earlier[t] & (1 << k) != 0;
+                    assert_eq!(shared, before, "{what}: triangle {t} side {k}");
+                    let first = (0..3 * t).find(|&uk| side(uk / 3, uk % 3) == side(t, k));
+                    let named = sides.first[3 * t + k];
+                    assert_eq!(
+                        first.map(|f| f as u32),
+                        (named != u32::MAX).then_some(named)
+                    );
+                }
+            }
+            for (e, along) in sides.along.iter().enumerate() {
+                assert_eq!(along.len(), edges[e] as usize, "{what}: edge {e}");
+                for &(t, k) in along {
+                    let (t, k) = (t as usize, k as usize);
+                    let on_edge = side(t, k).iter().all(|&p| pattern.bary(p)[e] == 0.0);
+                    let others = (0..pattern.triangles.len())
+                        .filter(|&u| (0..3).any(|l| side(u, l) == side(t, k)))
+                        .count();
+                    assert!(on_edge && others == 1, "{what}: edge {e} side {t}/{k}");
+                }
+            }
+        }
     }
 
     #[test]
