@@ -61,6 +61,11 @@ fn midpoint_side(s: usize) -> Option<usize> {
     (1..=3).contains(&s).then(|| s - 1)
 }
 
+/// The index in [`WEIGHTS`] of the midpoint of side `k`: [`midpoint_side`] the other way.
+fn midpoint_sample(k: u8) -> usize {
+    1 + usize::from(k)
+}
+
 /// The most points a pattern may have for [`with_candidate_errors`] to keep its sides' midpoint
 /// distances (a table of `n²`): a fill's polygon has at most 9.
 const SHARED_MIDPOINTS_UP_TO: usize = 64;
@@ -167,10 +172,18 @@ fn sampled_error(flat: [DVec3; 3], on_surface: &[SurfacePoint]) -> f64 {
 fn sampled_error_with(weights: &[[f64; 3]], flat: [DVec3; 3], on_surface: &[SurfacePoint]) -> f64 {
     let mut worst = 0.0f64;
     for (w, s) in weights.iter().zip(on_surface) {
-        let on_flat = w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2];
-        worst = worst.max(normal_distance(on_flat, s));
+        worst = worst.max(sample_distance(w, flat, s));
     }
     worst
+}
+
+/// The distance of the sample at weights `w` of the flat triangle `flat` from the surface's
+/// tangent plane at `on_surface`, the surface point of the same domain point: the one
+/// expression every check sums a sample with, so a side's midpoint has the same bits in every
+/// triangle that shares the side (see [`Candidate::Side`]).
+#[inline]
+fn sample_distance(w: &[f64; 3], flat: [DVec3; 3], on_surface: &SurfacePoint) -> f64 {
+    normal_distance(w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2], on_surface)
 }
 
 /// Where an output vertex at `p` is written: its `f32` rounding, as the tessellators write it
@@ -301,8 +314,7 @@ fn errors_by_part_once(
         let flat = corners.map(|p| vertices[p as usize]);
         let mut worst = 0.0f64;
         while let Some((&(_, s), point)) = at.next_if(|((u, _), _)| *u as usize == t) {
-            let w = WEIGHTS[s as usize];
-            let d = normal_distance(w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2], point);
+            let d = sample_distance(&WEIGHTS[s as usize], flat, point);
             if let Some(k) = midpoint_side(s as usize) {
                 midpoints[3 * t + k] = d;
             }
@@ -379,16 +391,13 @@ pub(crate) fn measured_within(
         // in a few points instead of whole triangles.
         barys.clear();
         for &(t, k) in first {
-            let s = 1 + k as usize;
-            barys.extend(sample_barys(pattern, t as usize).nth(s));
+            barys.extend(sample_barys(pattern, t as usize).nth(midpoint_sample(k)));
         }
         points.clear();
         evaluate(barys, points);
         for (&(t, k), point) in first.iter().zip(points.iter()) {
-            let s = 1 + k as usize;
             let flat = pattern.triangles[t as usize].map(|p| vertices[p as usize]);
-            let error = sampled_error_with(&WEIGHTS[s..=s], flat, std::slice::from_ref(point));
-            if error > tolerance {
+            if sample_distance(&WEIGHTS[midpoint_sample(k)], flat, point) > tolerance {
                 within = false;
                 return;
             }
@@ -439,19 +448,18 @@ pub(crate) enum Candidate {
     Side(u32, u32),
 }
 
-/// Calls `choose` once with `vertices`, those of `pattern` on source triangle `tri` as
-/// [`written_vertices`] gives them, and a function measuring a
-/// [`Candidate`] among those points (the triangles need not be among the pattern's own:
-/// `fill.rs` chooses among them); a candidate's samples are evaluated only when it is asked
-/// for, with one set-up of the source triangle for all of them
-/// ([`Surface::evaluate_points_on_demand`]).
+/// Calls `choose` once with a function measuring a [`Candidate`] among the points of `pattern`
+/// on source triangle `tri`, at `vertices` as [`written_vertices`] gives them (the triangles
+/// need not be among the pattern's own: `fill.rs` chooses among them); a candidate's samples
+/// are evaluated only when it is asked for, with one set-up of the source triangle for all of
+/// them ([`Surface::evaluate_points_on_demand`]).
 pub(crate) fn with_candidate_errors<R>(
     surface: &dyn Surface,
     tri: usize,
     pattern: &Pattern,
     vertices: &[DVec3],
     samples: &mut Samples,
-    choose: impl FnOnce(&[DVec3], &mut dyn FnMut(Candidate) -> f64) -> R,
+    choose: impl FnOnce(&mut dyn FnMut(Candidate) -> f64) -> R,
 ) -> R {
     let Samples {
         barys,
@@ -505,8 +513,7 @@ pub(crate) fn with_candidate_errors<R>(
             evaluate(barys, points);
             let flat = t.map(|p| vertices[p as usize]);
             for (&s, point) in measured[..count].iter().zip(points.iter()) {
-                let w = WEIGHTS[s];
-                let d = normal_distance(w[0] * flat[0] + w[1] * flat[1] + w[2] * flat[2], point);
+                let d = sample_distance(&WEIGHTS[s], flat, point);
                 if let Some(known) = midpoint_side(s).and_then(|k| midpoints.get_mut(slot(t, k))) {
                     *known = d;
                 }
@@ -515,7 +522,7 @@ pub(crate) fn with_candidate_errors<R>(
             worst
         };
         if let Some(choose) = choose.take() {
-            chosen = Some(choose(vertices, &mut error_of));
+            chosen = Some(choose(&mut error_of));
         }
     });
     chosen.expect("the surface calls `drive` once")
@@ -793,14 +800,9 @@ mod tests {
             }
         }
         let mut afresh = |candidate| {
-            with_candidate_errors(
-                &Field,
-                0,
-                &pattern,
-                &vertices,
-                &mut samples,
-                |_, error_of| error_of(candidate),
-            )
+            with_candidate_errors(&Field, 0, &pattern, &vertices, &mut samples, |error_of| {
+                error_of(candidate)
+            })
         };
         let alone: Vec<f64> = candidates.iter().map(|&c| afresh(c)).collect();
         // Every seventh, wrapping round: sides and triangles interleaved.
@@ -808,14 +810,10 @@ mod tests {
             .map(|i| i * 7 % candidates.len())
             .collect();
         assert_ne!(candidates.len() % 7, 0, "7 is prime to the count");
-        let together: Vec<f64> = with_candidate_errors(
-            &Field,
-            0,
-            &pattern,
-            &vertices,
-            &mut samples,
-            |_, error_of| order.iter().map(|&i| error_of(candidates[i])).collect(),
-        );
+        let together: Vec<f64> =
+            with_candidate_errors(&Field, 0, &pattern, &vertices, &mut samples, |error_of| {
+                order.iter().map(|&i| error_of(candidates[i])).collect()
+            });
         for (&i, error) in order.iter().zip(together) {
             assert_eq!(error.to_bits(), alone[i].to_bits(), "{:?}", candidates[i]);
             assert!(error > 0.0, "{:?}", candidates[i]);

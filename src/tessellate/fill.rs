@@ -63,59 +63,51 @@ pub(crate) fn fill_within(
         }
     }
     let points: Vec<[u32; 3]> = candidates.iter().map(|t| t.map(|v| outer[v])).collect();
-    let best_whole = with_candidate_errors(
-        surface,
-        tri,
-        &pattern,
-        vertices,
-        samples,
-        |vertices, error_of| {
-            // Every triangulation has a triangle on each side of the polygon, measuring at least
-            // the side's midpoint sample: one side over the tolerance leaves none within it.
-            if vertices.iter().all(|v| v.is_finite())
-                && (0..n)
-                    .any(|v| error_of(Candidate::Side(outer[v], outer[(v + 1) % n])) > tolerance)
-            {
-                return None;
-            }
-            let angle = |c: usize| angle_in_space(points[c].map(|p| vertices[p as usize]));
-            // best[lo·n + hi]: the largest smallest angle in space of sub-polygon lo..=hi's
-            // triangulations within the tolerance, and the first such triangulation's index. A
-            // candidate's error is measured only where it could change that: both its
-            // sub-polygons have such a triangulation and its angle beats the best found so far
-            // (on the Duck at a relative tolerance of 2e-4, a quarter of the candidates).
-            let mut best: Vec<Option<(f64, u32)>> = vec![None; n * n];
-            for lo in 0..n - 1 {
-                best[lo * n + lo + 1] = Some((f64::MAX, 0));
-            }
-            for span in 2..n {
-                for lo in 0..n - span {
-                    let hi = lo + span;
-                    let mut offset = 0u32;
-                    let mut found: Option<(f64, u32)> = None;
-                    for k in lo + 1..hi {
-                        let right_count = triangulations(hi - k + 1);
-                        let c = slot[(lo * n + k) * n + hi];
-                        if c != usize::MAX {
-                            if let (Some((left, li)), Some((right, ri))) =
-                                (best[lo * n + k], best[k * n + hi])
+    let best_whole = with_candidate_errors(surface, tri, &pattern, vertices, samples, |error_of| {
+        // Every triangulation has a triangle on each side of the polygon, measuring at least
+        // the side's midpoint sample: one side over the tolerance leaves none within it.
+        if vertices.iter().all(|v| v.is_finite())
+            && (0..n).any(|v| error_of(Candidate::Side(outer[v], outer[(v + 1) % n])) > tolerance)
+        {
+            return None;
+        }
+        let angle = |c: usize| angle_in_space(points[c].map(|p| vertices[p as usize]));
+        // best[lo·n + hi]: the largest smallest angle in space of sub-polygon lo..=hi's
+        // triangulations within the tolerance, and the first such triangulation's index. A
+        // candidate's error is measured only where it could change that: both its
+        // sub-polygons have such a triangulation and its angle beats the best found so far
+        // (on the Duck at a relative tolerance of 2e-4, a quarter of the candidates).
+        let mut best: Vec<Option<(f64, u32)>> = vec![None; n * n];
+        for lo in 0..n - 1 {
+            best[lo * n + lo + 1] = Some((f64::MAX, 0));
+        }
+        for span in 2..n {
+            for lo in 0..n - span {
+                let hi = lo + span;
+                let mut offset = 0u32;
+                let mut found: Option<(f64, u32)> = None;
+                for k in lo + 1..hi {
+                    let right_count = triangulations(hi - k + 1);
+                    let c = slot[(lo * n + k) * n + hi];
+                    if c != usize::MAX {
+                        if let (Some((left, li)), Some((right, ri))) =
+                            (best[lo * n + k], best[k * n + hi])
+                        {
+                            let angle = angle(c).min(left).min(right);
+                            if found.is_none_or(|(a, _)| angle > a)
+                                && error_of(Candidate::Triangle(points[c])) <= tolerance
                             {
-                                let angle = angle(c).min(left).min(right);
-                                if found.is_none_or(|(a, _)| angle > a)
-                                    && error_of(Candidate::Triangle(points[c])) <= tolerance
-                                {
-                                    found = Some((angle, offset + li * right_count + ri));
-                                }
+                                found = Some((angle, offset + li * right_count + ri));
                             }
                         }
-                        offset += triangulations(k - lo + 1) * right_count;
                     }
-                    best[lo * n + hi] = found;
+                    offset += triangulations(k - lo + 1) * right_count;
                 }
+                best[lo * n + hi] = found;
             }
-            best[n - 1]
-        },
-    );
+        }
+        best[n - 1]
+    });
     let (_, index) = best_whole?;
     debug_assert!(triangulation(n, index).all(|t| slot[(t[0] * n + t[1]) * n + t[2]] != usize::MAX));
     Some(u16::try_from(index + 1).expect("at most 429 triangulations of 9 points"))

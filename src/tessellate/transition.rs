@@ -119,7 +119,9 @@ impl Pattern {
             + std::mem::size_of_val(&self.lattice[..])
             + std::mem::size_of_val(&self.interior_by_rank[..])
             + std::mem::size_of_val(&self.triangles[..])
-            + 14 * self.triangles.len() // its sides' uses, once found
+            // Its sides' uses (`Sides`: 13 bytes a triangle, and the sides along the edges),
+            // counted before they are found, so that a store weighs the pattern once for all.
+            + 14 * self.triangles.len()
     }
 
     /// How the output triangles share their sides.
