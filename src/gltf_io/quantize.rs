@@ -17,6 +17,7 @@ use gltf_json::buffer::Target;
 use serde_json::{json, Value};
 
 use super::accessor;
+use super::bounds::float_bounds;
 use super::document::{Document, ReadOptions};
 use super::error::{Error, Result};
 use super::primitive::{collect_accessor_refs, push_accessor};
@@ -432,10 +433,10 @@ fn push(doc: &mut Document, e: &Encoded) -> usize {
     let (min, max) = if !e.bounds || count == 0 {
         (None, None)
     } else if let Some(f) = &e.floats {
-        let (lo, hi) = bounds(f, n, |x: &f32| *x);
+        let (lo, hi) = float_bounds(f, n);
         (Some(json!(lo)), Some(json!(hi)))
     } else {
-        let (lo, hi) = bounds(&e.values, n, |x: &i64| *x);
+        let (lo, hi) = integer_bounds(&e.values, n);
         (Some(json!(lo)), Some(json!(hi)))
     };
     let view = doc.push_view(
@@ -455,23 +456,14 @@ fn push(doc: &mut Document, e: &Encoded) -> usize {
     )
 }
 
-/// Per-component minimum and maximum of `values` (`n` components per element).
-fn bounds<T: Copy, U: PartialOrd + Copy>(
-    values: &[T],
-    n: usize,
-    f: impl Fn(&T) -> U,
-) -> (Vec<U>, Vec<U>) {
-    let (mut lo, mut hi): (Vec<U>, Vec<U>) = (
-        values[..n].iter().map(&f).collect(),
-        values[..n].iter().map(&f).collect(),
-    );
-    for (k, x) in values.iter().enumerate() {
-        let x = f(x);
-        if x < lo[k % n] {
-            lo[k % n] = x;
-        }
-        if x > hi[k % n] {
-            hi[k % n] = x;
+/// Per-component minimum and maximum of the integers `values` (`n ≥ 1` components per element,
+/// at least one element); the float ones are [`float_bounds`]'s, as every accessor's.
+fn integer_bounds(values: &[i64], n: usize) -> (Vec<i64>, Vec<i64>) {
+    let (mut lo, mut hi) = (values[..n].to_vec(), values[..n].to_vec());
+    for element in values.chunks_exact(n) {
+        for (k, &x) in element.iter().enumerate() {
+            lo[k] = lo[k].min(x);
+            hi[k] = hi[k].max(x);
         }
     }
     (lo, hi)
