@@ -83,12 +83,15 @@ pub struct AdaptiveFigures {
 
 impl Density {
     /// The density the options ask for; `level` is the file's level.
+    /// `h` the edges' widths and `groups` the output groups, as the tessellators take them.
     pub fn choose(
         options: &Options,
         level: u32,
         mesh: &TriMesh,
         topo: &Topology,
+        h: &[f64],
         surface: &dyn Surface,
+        groups: &[Range<usize>],
     ) -> Density {
         if !options.adaptive() {
             return Density::Level(level);
@@ -111,7 +114,10 @@ impl Density {
             target = target.min(options.relative_tolerance * diagonal(mesh));
         }
         let (counts, held) = if target > 0.0 && target.is_finite() {
-            errors.refine_to_tolerance_holding(topo, surface, target, cap, HELD_BYTES)
+            let (mut counts, held) =
+                errors.refine_to_tolerance_holding(topo, surface, target, cap, HELD_BYTES);
+            counts.pair_across_edges(mesh, topo, h, surface, target, groups);
+            (counts, held)
         } else {
             // A mesh of one point: nothing to refine.
             (SegmentCounts::uniform(topo, 1), HeldInteriors::default())

@@ -296,7 +296,15 @@ pub fn smooth_mesh(
     for (k, level_options) in levels.iter().enumerate() {
         let tess_start = Instant::now();
         let live = surface.as_deref().expect("freed after the last level only");
-        let density = Density::choose(level_options, level, &mesh, &topo, live);
+        let density = Density::choose(
+            level_options,
+            level,
+            &mesh,
+            &topo,
+            &effective,
+            live,
+            &groups,
+        );
         if previous.as_ref().is_some_and(|p| p.same_output(&density)) {
             // A looser tolerance (or a larger budget) that changes no count: a flat mesh at one
             // segment per edge, say, or a sidecar that fixes the mesh's density. The level

@@ -23,6 +23,7 @@ use super::emit;
 use super::held::{self, HeldInteriors};
 use super::kept_patterns::{self, Kept};
 use super::layout::GroupLayout;
+use super::pairs::{joined_polygon, Pair};
 use super::transition::{Pattern, PatternKey};
 use super::{DenseMesh, VertexSource, BLOCK_TRIANGLES};
 use crate::mesh::TriMesh;
@@ -82,6 +83,7 @@ pub fn tessellate_with_held(
         .par_iter()
         .map(|k| distinct.binary_search(k).expect("every key was built") as u32)
         .collect();
+    let pair_table = counts.pair_table();
     let shared = Shared {
         mesh,
         topo,
@@ -90,6 +92,7 @@ pub fn tessellate_with_held(
         held,
         patterns: &patterns,
         pattern_of: &pattern_of,
+        pair_table: &pair_table,
     };
     groups
         .par_iter()
@@ -106,6 +109,8 @@ struct Shared<'a> {
     held: &'a HeldInteriors,
     patterns: &'a [Kept<Pattern>],
     pattern_of: &'a [u32],
+    /// Per source triangle, its pair in `counts.pairs` ([`SegmentCounts::pair_table`]).
+    pair_table: &'a [u32],
 }
 
 impl Shared<'_> {
@@ -251,10 +256,73 @@ fn tessellate_block(
             }
         }
         let start = index_base[offset] - block.index_base;
-        emit::triangles(
-            &mut block.indices[start..start + 3 * pattern.triangles.len()],
-            &pattern.triangles,
-            &local,
-        );
+        let out = &mut block.indices[start..start + 3 * pattern.triangles.len()];
+        match shared.counts.pair_of(shared.pair_table, tri) {
+            Some((pair, side)) => write_share(shared, layout, first_tri, pair, side, out),
+            None => emit::triangles(out, &pattern.triangles, &local),
+        }
     }
+}
+
+/// Writes side `side`'s share of `pair`'s triangles (`pairs.rs`) into `out`, its index range:
+/// the joined polygon's points are the two triangles' corners and edge samples, numbered by
+/// `layout` whichever triangle writes them.
+fn write_share(
+    shared: &Shared<'_>,
+    layout: &GroupLayout,
+    first_tri: usize,
+    pair: &Pair,
+    side: usize,
+    out: &mut [u32],
+) {
+    let tris = pair.tris.map(|t| t as usize);
+    let patterns = tris.map(|t| shared.pattern(t));
+    let joined = joined_polygon(pair.sides, patterns);
+    let first_share = patterns[0].triangles.len();
+    let share = if side == 0 {
+        &pair.triangles[..first_share]
+    } else {
+        &pair.triangles[first_share..]
+    };
+    let slot = |q: u8| {
+        let (s, p) = joined[usize::from(q)];
+        point_slot(
+            layout,
+            shared.mesh,
+            tris[s] - first_tri,
+            tris[s],
+            patterns[s],
+            p,
+        )
+    };
+    for (dst, t) in out.chunks_exact_mut(3).zip(share) {
+        dst[0] = slot(t[0]);
+        dst[1] = slot(t[1]);
+        dst[2] = slot(t[2]);
+    }
+}
+
+/// The output vertex of point `p` (a corner or an edge sample) of source triangle `tri`, at
+/// `offset` in its group, cut by `pattern`: the slot the writer gives it.
+fn point_slot(
+    layout: &GroupLayout,
+    mesh: &TriMesh,
+    offset: usize,
+    tri: usize,
+    pattern: &Pattern,
+    p: u32,
+) -> u32 {
+    if p < 3 {
+        return layout.corner_slot[3 * offset + p as usize];
+    }
+    let k = (0..3)
+        .rev()
+        .find(|&k| p >= pattern.edge_start[k])
+        .expect("an edge sample");
+    let n = pattern.key.edges[k];
+    debug_assert!(p < pattern.edge_start[k] + n - 1, "{p} is an edge sample");
+    let corners = mesh.triangles[tri];
+    let ascending = corners[(k + 1) % 3] <= corners[(k + 2) % 3];
+    let m = p - pattern.edge_start[k] + 1;
+    emit::edge_slot(layout.edge_slot[3 * offset + k] as usize, ascending, n, m) as u32
 }

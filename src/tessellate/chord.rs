@@ -38,6 +38,7 @@ use rayon::prelude::*;
 use super::counts::SegmentCounts;
 use super::estimate::PatternError;
 use super::kept_patterns::{self, Kept};
+use super::pairs::joined_error;
 use super::transition::{Pattern, PatternKey};
 use super::DenseMesh;
 use crate::surface::{LatticePart, Surface, SurfacePoint};
@@ -96,9 +97,27 @@ pub fn chord_error(
     }
     assert_eq!(total, dense.indices.len(), "output of these counts");
     let position = |v: u32| DVec3::from(dense.positions[v as usize].map(f64::from));
+    let pair_table = counts.pair_table();
     (0..keys.len())
         .into_par_iter()
         .map_init(Samples::default, |samples, offset| {
+            if let Some((pair, side)) = counts.pair_of(&pair_table, group.start + offset) {
+                // The pair is measured once, as a whole, by its first triangle.
+                if side == 1 {
+                    return 0.0;
+                }
+                let offsets = pair.tris.map(|t| t as usize - group.start);
+                let both = offsets.map(|o| &*patterns[&keys[o]]);
+                let first_share = both[0].triangles.len();
+                return joined_error(topo, surface, pair, both, |u, c| {
+                    let (o, u) = if u < first_share {
+                        (offsets[0], u)
+                    } else {
+                        (offsets[1], u - first_share)
+                    };
+                    position(dense.indices[first_index[o] + 3 * u + c])
+                });
+            }
             let pattern = &patterns[&keys[offset]];
             let indices = &dense.indices[first_index[offset]..];
             pattern_error(
@@ -191,7 +210,7 @@ fn sample_distance(w: &[f64; 3], flat: [DVec3; 3], on_surface: &SurfacePoint) ->
 /// measure, as it is of what the report measures, and no allowance for it is kept under the
 /// tolerance.
 #[inline]
-fn written(p: DVec3) -> DVec3 {
+pub(super) fn written(p: DVec3) -> DVec3 {
     p.as_vec3().as_dvec3()
 }
 

@@ -36,10 +36,12 @@ use super::estimate::{Curvature, PatternError, PatternModel};
 use super::evaluator;
 use super::held::{HeldInteriors, Holding};
 use super::kept_patterns;
+use super::pairs::{self, Pair};
 use super::transition::{Pattern, PatternKey};
 use crate::mesh::TriMesh;
 use crate::surface::{lattice_index, Surface, SurfacePoint};
 use crate::topology::{EdgeId, Topology};
+use std::ops::Range;
 
 /// Lattice level of the probe: 28 surface points per triangle, a fifth of what level 16
 /// writes, and enough second differences to see a blending region's curvature.
@@ -128,6 +130,9 @@ pub struct SegmentCounts {
     /// by ears of largest minimum angle in the domain, but where the lowering of counts
     /// (`coarsen.rs`) chose a triangulation by measured chord error (`fill.rs`).
     pub fill: Vec<u16>,
+    /// Pairs of triangles cut as one polygon across the edge between them (`pairs.rs`), by
+    /// their first triangle; none but where [`SegmentCounts::pair_across_edges`] made them.
+    pub pairs: Vec<Pair>,
 }
 
 impl ChordErrors {
@@ -229,6 +234,7 @@ impl ChordErrors {
                 .map(|&c| initial_inner(need(c)))
                 .collect(),
             fill: vec![0; self.triangles.len()],
+            pairs: Vec::new(),
         };
         counts.balance(topo);
         counts
@@ -907,7 +913,48 @@ impl SegmentCounts {
             edges: vec![level; topo.edge_count()],
             inner: vec![level; topo.tri_edges.len()],
             fill: vec![0; topo.tri_edges.len()],
+            pairs: Vec::new(),
         }
+    }
+
+    /// Dissolves interior edges into the polygon of the two triangles beside them where that
+    /// saves triangles and a triangulation of it measures within `tolerance` (`pairs.rs`);
+    /// `groups` are the output groups, `h` the edges' widths (creases are kept).
+    #[allow(clippy::too_many_arguments)]
+    pub fn pair_across_edges(
+        &mut self,
+        mesh: &TriMesh,
+        topo: &Topology,
+        h: &[f64],
+        surface: &dyn Surface,
+        tolerance: f64,
+        groups: &[Range<usize>],
+    ) {
+        pairs::pair_across_edges(self, mesh, topo, h, surface, tolerance, groups);
+    }
+
+    /// The pair source triangle `tri` belongs to, and which of its two triangles it is, from a
+    /// table of [`SegmentCounts::pair_table`].
+    #[inline]
+    pub(crate) fn pair_of<'a>(&'a self, table: &[u32], tri: usize) -> Option<(&'a Pair, usize)> {
+        let index = *table.get(tri)?;
+        let pair = self.pairs.get(index as usize)?;
+        Some((pair, usize::from(pair.tris[1] as usize == tri)))
+    }
+
+    /// Per source triangle, the index of its pair in [`SegmentCounts::pairs`] (`u32::MAX`:
+    /// none); empty where there is no pair.
+    pub(crate) fn pair_table(&self) -> Vec<u32> {
+        if self.pairs.is_empty() {
+            return Vec::new();
+        }
+        let mut table = vec![u32::MAX; self.inner.len()];
+        for (i, pair) in self.pairs.iter().enumerate() {
+            for &t in &pair.tris {
+                table[t as usize] = i as u32;
+            }
+        }
+        table
     }
 
     /// The pattern key of source triangle `tri`.

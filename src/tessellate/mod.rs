@@ -63,6 +63,7 @@ mod held;
 mod kept_patterns;
 mod lattice_edges;
 mod layout;
+mod pairs;
 mod plan;
 mod transition;
 
@@ -79,6 +80,7 @@ pub use adaptive::{tessellate_with_counts, tessellate_with_held};
 pub use chord::chord_error;
 pub use counts::{ChordErrors, SegmentCounts, PROBE_KEPT_BYTES, PROBE_LEVEL};
 pub use held::{HeldInteriors, HELD_BYTES};
+pub use pairs::Pair;
 
 /// Where an output vertex was sampled: a source triangle (index into the whole mesh) and a point
 /// of that triangle's level-n lattice. Attributes are interpolated from these.

@@ -28,9 +28,18 @@ fn run(mesh: &TriMesh, h: f64, tolerance: f64, cap: u32) -> Run {
     let topo = Topology::build(mesh);
     let hs = h_all(&topo, h);
     let surface = G2Surface::new(mesh, &topo, &hs, Profile::C2);
-    let counts = ChordErrors::probe(mesh, &topo, &surface)
-        .refine_to_tolerance(&topo, &surface, tolerance, cap);
     let group = 0..mesh.triangles.len();
+    let mut counts = ChordErrors::probe(mesh, &topo, &surface)
+        .refine_to_tolerance(&topo, &surface, tolerance, cap);
+    // As the pipeline does: edges dissolved where two triangles' polygons cut as one pass.
+    counts.pair_across_edges(
+        mesh,
+        &topo,
+        &hs,
+        &surface,
+        tolerance,
+        std::slice::from_ref(&group),
+    );
     let dense = tessellate_with_counts(
         mesh,
         &topo,
@@ -279,6 +288,99 @@ fn a_torus_fills_triangles_flat_along_the_ring_from_their_edges() {
 }
 
 #[test]
+fn a_quad_torus_is_cut_across_its_diagonals_within_the_tolerance() {
+    // A torus of 125×40 quads (minor radius 0.35) at 1e-3: the tube edges need two segments
+    // (one chord of 9° of the tube is 1.08e-3 off), the ring edges one, and a quad's diagonal,
+    // across both curvatures at once, two (1.5e-3 at the outer equator). Cut triangle by
+    // triangle, each has five points and three triangles; with the diagonal dissolved
+    // (`pairs.rs`) a quad is the hexagon of its corners and tube midpoints, four triangles.
+    let mesh = torus_rings(125, 40, 0.35);
+    let tolerance = 1e-3;
+    let r = run(&mesh, 0.2, tolerance, 64);
+    let triangles = r.dense.indices.len() / 3;
+    let paired = 2 * r.counts.pairs.len();
+    println!(
+        "torus 125×40 at {tolerance:e}: {triangles} triangles, {paired} of {} source triangles paired, measured {:.3e}",
+        mesh.triangles.len(),
+        r.measured
+    );
+    assert_eq!(triangles as u64, r.counts.triangle_count(&r.topo));
+    // On the inner half of the tube the ring's curvature is opposite the tube's and the
+    // diagonal needs one segment by itself (8.7e-4 at the inner equator): those quads are cut
+    // in four as they are.
+    assert!(paired * 2 >= mesh.triangles.len(), "{paired} paired");
+    assert!(triangles <= 2 * mesh.triangles.len(), "{triangles}");
+    assert!(r.measured <= tolerance, "{}", r.measured);
+    // Measured apart from the chart: the output's distance from the exact torus at points
+    // of every output triangle (a 6×6 grid of barycentrics, not the check's seven) is at
+    // most the tolerance plus the surface's own distance from the torus, and the second
+    // order of the tangent plane's distance (κ|X − S|²/2 with |X − S| a chord's sagitta,
+    // far below 1e-6 here).
+    let torus_distance = |p: DVec3| {
+        let ring = (p.x * p.x + p.y * p.y).sqrt() - 1.0;
+        ((ring * ring + p.z * p.z).sqrt() - 0.35).abs()
+    };
+    let topo = &r.topo;
+    let hs = h_all(topo, 0.2);
+    let surface = G2Surface::new(&mesh, topo, &hs, Profile::C2);
+    let mut on_surface = 0.0f64;
+    let mut points = Vec::new();
+    for t in 0..mesh.triangles.len() {
+        points.clear();
+        surface.evaluate_lattice(t, 8, &mut points);
+        for p in &points {
+            on_surface = on_surface.max(torus_distance(p.position));
+        }
+    }
+    let mut flat = 0.0f64;
+    let at = |v: u32| DVec3::from(r.dense.positions[v as usize].map(f64::from));
+    for t in r.dense.indices.chunks_exact(3) {
+        let [a, b, c] = [at(t[0]), at(t[1]), at(t[2])];
+        for i in 0..=6 {
+            for j in 0..=6 - i {
+                let (u, v) = (i as f64 / 6.0, j as f64 / 6.0);
+                flat = flat.max(torus_distance(a + u * (b - a) + v * (c - a)));
+            }
+        }
+    }
+    println!("  distance from the torus: output {flat:.3e}, surface {on_surface:.3e}");
+    assert!(
+        flat <= tolerance + on_surface + 1e-6,
+        "{flat} from the torus, the surface {on_surface}"
+    );
+    // The dissolved edges are smooth edges of two triangles with the same input vertices,
+    // their polygons without interior.
+    for pair in &r.counts.pairs {
+        let [t0, t1] = pair.tris.map(|t| t as usize);
+        let e = topo.tri_edges[t0][pair.sides[0] as usize];
+        assert_eq!(e, topo.tri_edges[t1][pair.sides[1] as usize]);
+        assert_eq!(r.counts.edges[e.0 as usize], 1);
+        assert!(r.counts.inner[t0] <= 2 && r.counts.inner[t1] <= 2);
+    }
+}
+
+#[test]
+fn creases_and_seams_are_not_dissolved() {
+    // The same torus with every edge a crease (h = 0), and with every vertex split per
+    // triangle (split normals): no two triangles are cut as one, at the tolerance where the
+    // smooth torus dissolves more than half of its diagonals.
+    let mesh = torus_rings(125, 40, 0.35);
+    let r = run(&mesh, 0.0, 1e-3, 64);
+    assert!(
+        r.counts.pairs.is_empty(),
+        "{} pairs across creases",
+        r.counts.pairs.len()
+    );
+    let split = split_normals(&mesh, 0.0);
+    let r = run(&split, 0.2, 1e-3, 64);
+    assert!(
+        r.counts.pairs.is_empty(),
+        "{} pairs across seams",
+        r.counts.pairs.len()
+    );
+}
+
+#[test]
 fn watertight_at_every_tolerance() {
     let meshes = [
         ("torus", torus(10)),
@@ -346,6 +448,17 @@ fn the_same_bytes_at_any_thread_count() {
     let surface = G2Surface::new(&mesh, &topo, &hs, Profile::C2);
     let half = mesh.triangles.len() / 3;
     let groups = [0..half, half..mesh.triangles.len()];
+    // Dissolved edges need triangles that share their input vertices, and a tolerance at which
+    // polygons without interior are cut.
+    // A torus of quads, with creases on every fifth edge and a group border as above.
+    let plain = torus_rings(125, 40, 0.35);
+    let plain_topo = Topology::build(&plain);
+    let mut plain_asked = vec![0.2; plain_topo.edge_count()];
+    plain_asked.iter_mut().step_by(5).for_each(|x| *x = 0.0);
+    let plain_hs = widths(&plain_topo, &plain_asked);
+    let plain_surface = G2Surface::new(&plain, &plain_topo, &plain_hs, Profile::C2);
+    let third = plain.triangles.len() / 3;
+    let plain_groups = [0..third, third..plain.triangles.len()];
     let once = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -354,18 +467,26 @@ fn the_same_bytes_at_any_thread_count() {
             .install(|| {
                 let counts = ChordErrors::probe(&mesh, &topo, &surface).counts(&topo, 1e-4, 64);
                 let dense = tessellate_with_counts(&mesh, &topo, &hs, &surface, &counts, &groups);
-                (counts, dense)
+                // Coarse enough for edges to be dissolved, beside creases and a group border.
+                let (m, t, h, s) = (&plain, &plain_topo, &plain_hs, &plain_surface);
+                let mut paired = ChordErrors::probe(m, t, s).refine_to_tolerance(t, s, 1e-3, 64);
+                paired.pair_across_edges(m, t, h, s, 1e-3, &plain_groups);
+                let joined = tessellate_with_counts(m, t, h, s, &paired, &plain_groups);
+                (counts, dense, paired, joined)
             })
     };
-    let (c1, d1) = once(1);
+    let (c1, d1, p1, j1) = once(1);
     assert!(
         d1.iter().map(|d| d.indices.len() / 3).sum::<usize>() > 4 * 16 * 1024,
         "several blocks"
     );
+    assert!(!p1.pairs.is_empty(), "no edge dissolved");
     for threads in [2, 3] {
-        let (c, d) = once(threads);
+        let (c, d, p, j) = once(threads);
         assert_eq!(c, c1, "{threads} threads");
         assert_eq!(d, d1, "{threads} threads");
+        assert_eq!(p, p1, "{threads} threads");
+        assert_eq!(j, j1, "{threads} threads");
     }
 }
 
