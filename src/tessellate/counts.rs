@@ -36,12 +36,11 @@ use super::estimate::{Curvature, PatternError, PatternModel};
 use super::evaluator;
 use super::held::{HeldInteriors, Holding};
 use super::kept_patterns;
-use super::pairs::{self, Pair};
+use super::pairs::Pair;
 use super::transition::{Pattern, PatternKey};
 use crate::mesh::TriMesh;
 use crate::surface::{lattice_index, Surface, SurfacePoint};
 use crate::topology::{EdgeId, Topology};
-use std::ops::Range;
 
 /// Lattice level of the probe: 28 surface points per triangle, a fifth of what level 16
 /// writes, and enough second differences to see a blending region's curvature.
@@ -915,22 +914,6 @@ impl SegmentCounts {
             fill: vec![0; topo.tri_edges.len()],
             pairs: Vec::new(),
         }
-    }
-
-    /// Dissolves interior edges into the polygon of the two triangles beside them where that
-    /// saves triangles and a triangulation of it measures within `tolerance` (`pairs.rs`);
-    /// `groups` are the output groups, `h` the edges' widths (creases are kept).
-    #[allow(clippy::too_many_arguments)]
-    pub fn pair_across_edges(
-        &mut self,
-        mesh: &TriMesh,
-        topo: &Topology,
-        h: &[f64],
-        surface: &dyn Surface,
-        tolerance: f64,
-        groups: &[Range<usize>],
-    ) {
-        pairs::pair_across_edges(self, mesh, topo, h, surface, tolerance, groups);
     }
 
     /// The pair source triangle `tri` belongs to, and which of its two triangles it is, from a

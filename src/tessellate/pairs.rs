@@ -77,7 +77,7 @@ pub struct Pair {
 
 /// A point of the joined polygon: which triangle of the pair (0 or 1) and its point in that
 /// triangle's pattern.
-pub(crate) type JoinedPoint = (usize, u32);
+type JoinedPoint = (usize, u32);
 
 /// The joined polygon of `pair` cut by `patterns` (each with one segment on the shared edge),
 /// counter-clockwise in the first triangle's winding: the first triangle's polygon from the end
@@ -106,14 +106,14 @@ pub(crate) fn joined_polygon(sides: [u8; 2], patterns: [&Pattern; 2]) -> Vec<Joi
 }
 
 /// The two triangles of a pair laid flat side by side (see the module docs).
-pub(crate) struct Chart {
+struct Chart {
     /// Each triangle's corners on the chart, in its own corner order.
     corners: [[DVec2; 3]; 2],
 }
 
 impl Chart {
     /// The chart of triangles `tris`, sharing their edges `sides`, from the welded positions.
-    pub fn new(topo: &Topology, tris: [usize; 2], sides: [u8; 2]) -> Chart {
+    fn new(topo: &Topology, tris: [usize; 2], sides: [u8; 2]) -> Chart {
         let at = |t: usize, c: usize| topo.welded_positions[topo.tri_verts[t][c].0 as usize];
         let mut corners = [[DVec2::ZERO; 3]; 2];
         for (s, &t) in tris.iter().enumerate() {
@@ -137,14 +137,14 @@ impl Chart {
     }
 
     /// Where point `bary` of triangle `s` of the pair lies on the chart.
-    pub fn place(&self, s: usize, bary: [f64; 3]) -> DVec2 {
+    fn place(&self, s: usize, bary: [f64; 3]) -> DVec2 {
         let c = &self.corners[s];
         bary[0] * c[0] + bary[1] * c[1] + bary[2] * c[2]
     }
 
     /// Which triangle of the pair (0 or 1) holds chart point `q`, and its barycentrics there:
     /// the first where it holds `q` (up to rounding), else the second, clamped to it.
-    pub fn locate(&self, q: DVec2) -> (usize, [f64; 3]) {
+    fn locate(&self, q: DVec2) -> (usize, [f64; 3]) {
         let bary_in = |c: &[DVec2; 3]| {
             let (u, v, w) = (c[1] - c[0], c[2] - c[0], q - c[0]);
             let det = u.perp_dot(v);
@@ -169,7 +169,7 @@ fn normalized(b: [f64; 3]) -> [f64; 3] {
 
 /// Evaluates points of either triangle of a pair: `(s, barys, out)` appends the points of
 /// triangle `s` of the pair at `barys` to `out`.
-pub(crate) type OnBoth<'a> = dyn FnMut(usize, &[[f64; 3]], &mut Vec<SurfacePoint>) + 'a;
+type OnBoth<'a> = dyn FnMut(usize, &[[f64; 3]], &mut Vec<SurfacePoint>) + 'a;
 
 /// Calls `f` with an evaluator of both triangles `tris` that sets each up once for all its
 /// calls ([`Surface::evaluate_points_on_demand`]), where one evaluation per sample set the
@@ -200,7 +200,7 @@ fn with_both<R>(
 
 /// Scratch buffers of [`joined_triangle_error`].
 #[derive(Debug, Default)]
-pub(crate) struct JoinedSamples {
+struct JoinedSamples {
     barys: [Vec<[f64; 3]>; 2],
     points: [Vec<SurfacePoint>; 2],
 }
@@ -209,7 +209,7 @@ pub(crate) struct JoinedSamples {
 /// positions `flat`: the largest distance of its [`WEIGHTS`] samples from the surface's tangent
 /// plane at the surface point under each, found through `on_chart` and evaluated by `both`,
 /// each triangle's samples in one call.
-pub(crate) fn joined_triangle_error(
+fn joined_triangle_error(
     both: &mut OnBoth<'_>,
     on_chart: &Chart,
     chart: [DVec2; 3],
@@ -283,96 +283,100 @@ pub(crate) fn joined_error(
 /// pattern keys with one segment there.
 type Candidate = (usize, [usize; 2], [u8; 2], [PatternKey; 2]);
 
-/// Dissolves the interior edges of `counts` that the module docs say, where a triangulation of
-/// the joined polygon measures within `tolerance`; `groups` are the output groups (a pair stays
-/// in one), `h` the edges' widths.
-pub(crate) fn pair_across_edges(
-    counts: &mut SegmentCounts,
-    mesh: &TriMesh,
-    topo: &Topology,
-    h: &[f64],
-    surface: &dyn Surface,
-    tolerance: f64,
-    groups: &[Range<usize>],
-) {
-    let mut group_of = vec![u32::MAX; counts.inner.len()];
-    for (g, range) in groups.iter().enumerate() {
-        group_of[range.clone()]
-            .iter_mut()
-            .for_each(|x| *x = g as u32);
-    }
-    // Per edge that could be dissolved: the edge, its triangles, their sides on it, and their
-    // pattern keys with one segment there.
-    let candidates: Vec<Candidate> = (0..topo.edge_count())
-        .into_par_iter()
-        .filter_map(|e| {
-            let id = EdgeId(e as u32);
-            if counts.edges[e] < 2
-                || topo.edge_kind(id) != EdgeKind::Interior
-                || is_crease(topo, h, id)
-            {
-                return None;
-            }
-            // An interior edge has two distinct triangles, the lower-numbered first.
-            let uses = topo.edge_uses(id);
-            let [(t0, k0), (t1, k1)] = [uses[0].at(), uses[1].at()];
-            if group_of[t0] != group_of[t1] || group_of[t0] == u32::MAX {
-                return None;
-            }
-            // The same input vertices, the second triangle running the edge the other way.
-            let ends = |t: usize, k: usize| {
-                let v = mesh.triangles[t];
-                (v[(k + 1) % 3], v[(k + 2) % 3])
-            };
-            let ((a0, b0), (a1, b1)) = (ends(t0, k0), ends(t1, k1));
-            if (a0, b0) != (b1, a1) {
-                return None;
-            }
-            let keys = [(t0, k0), (t1, k1)].map(|(t, k)| {
-                let mut key = counts.key(topo, t);
-                key.edges[k] = 1;
-                key.fill = 0;
-                key
-            });
-            // Without interior points on both sides, one segment or not.
-            (keys[0].inner <= 2 && keys[1].inner <= 2).then_some((
-                e,
-                [t0, t1],
-                [k0 as u8, k1 as u8],
-                keys,
-            ))
-        })
-        .collect();
-    let found: Vec<Option<Pair>> = candidates
-        .par_iter()
-        .map_init(
-            JoinedSamples::default,
-            |scratch, &(_, tris, sides, keys)| {
-                joined_fill(surface, topo, tris, sides, keys, tolerance, scratch)
-            },
-        )
-        .collect();
-    // Most triangles saved first (two per segment taken off the edge), then by edge.
-    let mut order: Vec<usize> = (0..candidates.len())
-        .filter(|&c| found[c].is_some())
-        .collect();
-    order.sort_by_key(|&c| (std::cmp::Reverse(counts.edges[candidates[c].0]), c));
-    let mut taken = vec![false; counts.inner.len()];
-    let mut pairs = Vec::new();
-    for c in order {
-        let (e, tris, _, _) = candidates[c];
-        if tris.iter().any(|&t| taken[t]) {
-            continue;
+impl SegmentCounts {
+    /// Dissolves the interior edges the module docs say into the polygon of the two triangles
+    /// beside them, where that saves triangles and a triangulation of it measures within
+    /// `tolerance`; `groups` are the output groups (a pair stays in one), `h` the edges' widths
+    /// (creases are kept).
+    pub fn pair_across_edges(
+        &mut self,
+        mesh: &TriMesh,
+        topo: &Topology,
+        h: &[f64],
+        surface: &dyn Surface,
+        tolerance: f64,
+        groups: &[Range<usize>],
+    ) {
+        let counts = self;
+        let mut group_of = vec![u32::MAX; counts.inner.len()];
+        for (g, range) in groups.iter().enumerate() {
+            group_of[range.clone()]
+                .iter_mut()
+                .for_each(|x| *x = g as u32);
         }
-        tris.iter().for_each(|&t| taken[t] = true);
-        counts.edges[e] = 1;
-        for &t in &tris {
-            counts.fill[t] = 0;
+        // Per edge that could be dissolved: the edge, its triangles, their sides on it, and their
+        // pattern keys with one segment there.
+        let candidates: Vec<Candidate> = (0..topo.edge_count())
+            .into_par_iter()
+            .filter_map(|e| {
+                let id = EdgeId(e as u32);
+                if counts.edges[e] < 2
+                    || topo.edge_kind(id) != EdgeKind::Interior
+                    || is_crease(topo, h, id)
+                {
+                    return None;
+                }
+                // An interior edge has two distinct triangles, the lower-numbered first.
+                let uses = topo.edge_uses(id);
+                let [(t0, k0), (t1, k1)] = [uses[0].at(), uses[1].at()];
+                if group_of[t0] != group_of[t1] || group_of[t0] == u32::MAX {
+                    return None;
+                }
+                // The same input vertices, the second triangle running the edge the other way.
+                let ends = |t: usize, k: usize| {
+                    let v = mesh.triangles[t];
+                    (v[(k + 1) % 3], v[(k + 2) % 3])
+                };
+                let ((a0, b0), (a1, b1)) = (ends(t0, k0), ends(t1, k1));
+                if (a0, b0) != (b1, a1) {
+                    return None;
+                }
+                let keys = [(t0, k0), (t1, k1)].map(|(t, k)| {
+                    let mut key = counts.key(topo, t);
+                    key.edges[k] = 1;
+                    key.fill = 0;
+                    key
+                });
+                // Without interior points on both sides, one segment or not.
+                (keys[0].inner <= 2 && keys[1].inner <= 2).then_some((
+                    e,
+                    [t0, t1],
+                    [k0 as u8, k1 as u8],
+                    keys,
+                ))
+            })
+            .collect();
+        let found: Vec<Option<Pair>> = candidates
+            .par_iter()
+            .map_init(
+                JoinedSamples::default,
+                |scratch, &(_, tris, sides, keys)| {
+                    joined_fill(surface, topo, tris, sides, keys, tolerance, scratch)
+                },
+            )
+            .collect();
+        // Most triangles saved first (two per segment taken off the edge), then by edge.
+        let mut order: Vec<usize> = (0..candidates.len())
+            .filter(|&c| found[c].is_some())
+            .collect();
+        order.sort_by_key(|&c| (std::cmp::Reverse(counts.edges[candidates[c].0]), c));
+        let mut taken = vec![false; counts.inner.len()];
+        let mut pairs = Vec::new();
+        for c in order {
+            let (e, tris, _, _) = candidates[c];
+            if tris.iter().any(|&t| taken[t]) {
+                continue;
+            }
+            tris.iter().for_each(|&t| taken[t] = true);
+            counts.edges[e] = 1;
+            for &t in &tris {
+                counts.fill[t] = 0;
+            }
+            pairs.push(found[c].clone().expect("only those found"));
         }
-        pairs.push(found[c].clone().expect("only those found"));
+        pairs.sort_by_key(|p| p.tris[0]);
+        counts.pairs = pairs;
     }
-    pairs.sort_by_key(|p| p.tris[0]);
-    counts.pairs = pairs;
 }
 
 /// Whether the chart triangle `t` is wound counter-clockwise with every angle at least

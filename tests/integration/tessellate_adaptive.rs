@@ -237,7 +237,9 @@ fn a_torus_fills_triangles_flat_along_the_ring_from_their_edges() {
     // tolerance (`coarsen.rs`) gives 13,200, with both balance rules kept. Where a step lowers
     // a pattern to no interior and its default fill (ears by angle in the domain) fails, the
     // fill chosen by measured error (`fill.rs`) lets it pass: 11,900, under the 12,900 of
-    // Manifold's `refine_to_tolerance` as close to the torus (`tests/benches/adaptive`).
+    // Manifold's `refine_to_tolerance` as close to the torus (`tests/benches/adaptive`). Edges
+    // between two triangles without interior points, dissolved where the polygon of both cut
+    // as one passes (`pairs.rs`), give 11,300.
     let mesh = torus_rings(50, 20, 0.35);
     let tolerance = 1e-3;
     let r = run(&mesh, 0.2, tolerance, 64);
@@ -271,7 +273,7 @@ fn a_torus_fills_triangles_flat_along_the_ring_from_their_edges() {
         adaptive * 5 <= mesh.triangles.len() * 9 * 4,
         "{adaptive} triangles: over 0.8 of uniform level 3"
     );
-    assert!(adaptive <= 12_000, "{adaptive} triangles: counts left high");
+    assert!(adaptive <= 11_500, "{adaptive} triangles: counts left high");
     for (t, edges) in topo.tri_edges.iter().enumerate() {
         let edges = edges.map(|e| r.counts.edges[e.0 as usize]);
         let inner = r.counts.inner[t];
