@@ -117,6 +117,7 @@ impl Density {
             let (mut counts, held) =
                 errors.refine_to_tolerance_holding(topo, surface, target, cap, HELD_BYTES);
             counts.pair_across_edges(mesh, topo, h, surface, target, groups);
+            counts.rows_across_edges(mesh, topo, h, surface, target, cap, groups);
             (counts, held)
         } else {
             // A mesh of one point: nothing to refine.

@@ -24,6 +24,7 @@ use super::held::{self, HeldInteriors};
 use super::kept_patterns::{self, Kept};
 use super::layout::GroupLayout;
 use super::pairs::{joined_polygon, Pair};
+use super::rows::ROW_LEVEL;
 use super::transition::{Pattern, PatternKey};
 use super::{DenseMesh, VertexSource, BLOCK_TRIANGLES};
 use crate::mesh::TriMesh;
@@ -117,6 +118,15 @@ impl Shared<'_> {
     fn pattern(&self, tri: usize) -> &Pattern {
         &self.patterns[self.pattern_of[tri] as usize]
     }
+
+    /// How many triangles source triangle `tri` writes: its pattern's, or its share of its pair.
+    fn triangles_of(&self, tri: usize) -> usize {
+        let own = self.pattern(tri).triangles.len();
+        match self.counts.pair_of(self.pair_table, tri) {
+            Some((pair, side)) => pair.share_len(side, own),
+            None => own,
+        }
+    }
 }
 
 fn tessellate_group(shared: &Shared<'_>, h: &[f64], range: Range<usize>) -> DenseMesh {
@@ -129,7 +139,8 @@ fn tessellate_group(shared: &Shared<'_>, h: &[f64], range: Range<usize>) -> Dens
         |tri, k| counts.edges[topo.tri_edges[tri][k].0 as usize] - 1,
         |tri| {
             let m = counts.inner[tri];
-            m.saturating_sub(1) * m.saturating_sub(2) / 2
+            let rows = counts.row_points_of(shared.pair_table, tri) as u32;
+            m.saturating_sub(1) * m.saturating_sub(2) / 2 + rows
         },
     );
     // First index of each source triangle's triangles.
@@ -137,7 +148,7 @@ fn tessellate_group(shared: &Shared<'_>, h: &[f64], range: Range<usize>) -> Dens
     let mut total = 0usize;
     for tri in range.clone() {
         index_base.push(total);
-        total += 3 * shared.pattern(tri).triangles.len();
+        total += 3 * shared.triangles_of(tri);
     }
     index_base.push(total);
 
@@ -184,6 +195,8 @@ fn tessellate_block(
     let mut writer = emit::TriangleWriter::new(mesh, topo, surface);
     let mut local: Vec<u32> = Vec::new();
     let mut parts = Vec::with_capacity(4);
+    let mut barys = Vec::new();
+    let mut evaluated = Vec::new();
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
         let pattern = shared.pattern(tri);
@@ -255,11 +268,39 @@ fn tessellate_block(
                 ),
             }
         }
-        let start = index_base[offset] - block.index_base;
-        let out = &mut block.indices[start..start + 3 * pattern.triangles.len()];
+        let (start, end) = (
+            index_base[offset] - block.index_base,
+            index_base[offset + 1] - block.index_base,
+        );
         match shared.counts.pair_of(shared.pair_table, tri) {
-            Some((pair, side)) => write_share(shared, layout, first_tri, pair, side, out),
-            None => emit::triangles(out, &pattern.triangles, &local),
+            Some((pair, side)) => {
+                let own = pair.interior.iter().filter(|p| usize::from(p.side) == side);
+                if own.clone().next().is_some() {
+                    // The points inside a quad cut in rows (`rows.rs`) that are this triangle's,
+                    // after its pattern's (it has none): lattice points of their own level.
+                    barys.clear();
+                    barys.extend(own.clone().map(|p| p.bary()));
+                    evaluated.clear();
+                    surface.evaluate_points(tri, &barys, &mut evaluated);
+                    let first_slot = layout.base[offset + 1] as usize - evaluated.len();
+                    for (rank, (p, at)) in own.zip(&evaluated).enumerate() {
+                        block.put(
+                            first_slot + rank,
+                            at.position.as_vec3().to_array(),
+                            at.normal.as_vec3().to_array(),
+                            VertexSource::lattice(
+                                tri as u32,
+                                ROW_LEVEL,
+                                u32::from(p.i),
+                                u32::from(p.j),
+                            ),
+                        );
+                    }
+                }
+                let out = &mut block.indices[start..end];
+                write_share(shared, layout, first_tri, pair, side, out)
+            }
+            None => emit::triangles(&mut block.indices[start..end], &pattern.triangles, &local),
         }
     }
 }
@@ -278,14 +319,26 @@ fn write_share(
     let tris = pair.tris.map(|t| t as usize);
     let patterns = tris.map(|t| shared.pattern(t));
     let joined = joined_polygon(pair.sides, patterns);
-    let first_share = patterns[0].triangles.len();
+    let first_share = pair.share_len(0, patterns[0].triangles.len());
     let share = if side == 0 {
         &pair.triangles[..first_share]
     } else {
         &pair.triangles[first_share..]
     };
+    let n = joined.len();
     let slot = |q: u8| {
-        let (s, p) = joined[usize::from(q)];
+        let Some(&(s, p)) = joined.get(usize::from(q)) else {
+            // A point inside (`rows.rs`): its triangle's interior slots are its points, the
+            // first triangle's first.
+            let r = usize::from(q) - n;
+            let s = usize::from(pair.interior[r].side);
+            let (before, own) = (
+                if s == 1 { pair.interior_of(0) } else { 0 },
+                pair.interior_of(s),
+            );
+            let offset = tris[s] - first_tri;
+            return layout.base[offset + 1] - (own - (r - before)) as u32;
+        };
         point_slot(
             layout,
             shared.mesh,

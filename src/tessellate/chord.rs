@@ -87,17 +87,18 @@ pub fn chord_error(
     let mut patterns: HashMap<PatternKey, Kept<Pattern>> = HashMap::new();
     let mut first_index = Vec::with_capacity(keys.len());
     let mut total = 0usize;
-    for &key in &keys {
+    let pair_table = counts.pair_table();
+    for (offset, &key) in keys.iter().enumerate() {
         first_index.push(total);
-        total += 3 * patterns
+        let own = patterns
             .entry(key)
             .or_insert_with(|| kept_patterns::pattern(key))
             .triangles
             .len();
+        total += 3 * (own + 2 * counts.row_points_of(&pair_table, group.start + offset));
     }
     assert_eq!(total, dense.indices.len(), "output of these counts");
     let position = |v: u32| DVec3::from(dense.positions[v as usize].map(f64::from));
-    let pair_table = counts.pair_table();
     (0..keys.len())
         .into_par_iter()
         .map_init(Samples::default, |samples, offset| {
@@ -108,7 +109,7 @@ pub fn chord_error(
                 }
                 let offsets = pair.tris.map(|t| t as usize - group.start);
                 let both = offsets.map(|o| &*patterns[&keys[o]]);
-                let first_share = both[0].triangles.len();
+                let first_share = pair.share_len(0, both[0].triangles.len());
                 return joined_error(topo, surface, pair, both, |u, c| {
                     let (o, u) = if u < first_share {
                         (offsets[0], u)

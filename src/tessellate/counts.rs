@@ -129,8 +129,10 @@ pub struct SegmentCounts {
     /// by ears of largest minimum angle in the domain, but where the lowering of counts
     /// (`coarsen.rs`) chose a triangulation by measured chord error (`fill.rs`).
     pub fill: Vec<u16>,
-    /// Pairs of triangles cut as one polygon across the edge between them (`pairs.rs`), by
-    /// their first triangle; none but where [`SegmentCounts::pair_across_edges`] made them.
+    /// Pairs of triangles cut as one polygon across the edge between them (`pairs.rs`), or
+    /// as one quad in rows with points inside (`rows.rs`), by their first triangle; none but
+    /// where [`SegmentCounts::pair_across_edges`] and [`SegmentCounts::rows_across_edges`]
+    /// made them.
     pub pairs: Vec<Pair>,
 }
 
@@ -925,6 +927,14 @@ impl SegmentCounts {
         Some((pair, usize::from(pair.tris[1] as usize == tri)))
     }
 
+    /// How many of the points inside source triangle `tri`'s pair (`rows.rs`) are its own, from
+    /// a table of [`SegmentCounts::pair_table`]: 0 where it has none.
+    #[inline]
+    pub(crate) fn row_points_of(&self, table: &[u32], tri: usize) -> usize {
+        self.pair_of(table, tri)
+            .map_or(0, |(pair, side)| pair.interior_of(side))
+    }
+
     /// Per source triangle, the index of its pair in [`SegmentCounts::pairs`] (`u32::MAX`:
     /// none); empty where there is no pair.
     pub(crate) fn pair_table(&self) -> Vec<u32> {
@@ -952,9 +962,16 @@ impl SegmentCounts {
 
     /// Output triangles, from the counts alone.
     pub fn triangle_count(&self, topo: &Topology) -> u64 {
-        (0..self.inner.len())
+        let patterns: u64 = (0..self.inner.len())
             .map(|t| self.key(topo, t).triangle_count())
-            .sum()
+            .sum();
+        // Two more per point inside a pair (`rows.rs`).
+        patterns
+            + self
+                .pairs
+                .iter()
+                .map(|p| 2 * p.interior.len() as u64)
+                .sum::<u64>()
     }
 
     /// Largest count anywhere.

@@ -65,6 +65,7 @@ mod lattice_edges;
 mod layout;
 mod pairs;
 mod plan;
+mod rows;
 mod transition;
 
 use crate::mesh::TriMesh;
@@ -81,6 +82,7 @@ pub use chord::chord_error;
 pub use counts::{ChordErrors, SegmentCounts, PROBE_KEPT_BYTES, PROBE_LEVEL};
 pub use held::{HeldInteriors, HELD_BYTES};
 pub use pairs::Pair;
+pub use rows::{RowPoint, ROW_LEVEL};
 
 /// Where an output vertex was sampled: a source triangle (index into the whole mesh) and a point
 /// of that triangle's level-n lattice. Attributes are interpolated from these.

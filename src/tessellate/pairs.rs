@@ -54,6 +54,7 @@ use super::chord::{angle_in_space, normal_distance, written, WEIGHTS};
 use super::counts::SegmentCounts;
 use super::is_crease;
 use super::kept_patterns::{self, Kept};
+use super::rows::RowPoint;
 #[cfg(test)]
 use super::transition::min_angle;
 use super::transition::{polygon, Pattern, PatternKey, ANGLE_FLOOR};
@@ -70,14 +71,52 @@ pub struct Pair {
     /// Each one's local edge (opposite that corner) on the dissolved edge.
     pub sides: [u8; 2],
     /// The triangulation of the joined polygon (the two triangles' polygons joined along the
-    /// edge, counter-clockwise from the end of the first's side of it), as positions in it: the
-    /// first triangle writes the first `k₁ − 2`, the second the rest.
+    /// edge, counter-clockwise from the end of the first's side of it), as positions in it,
+    /// and past its `n` points, `n + r` for interior point `r`: the first triangle writes the
+    /// first `k₁ − 2 + 2·i₁` (`i₁` of the interior points are its own), the second the rest.
     pub triangles: Vec<[u8; 3]>,
+    /// Points inside the joined polygon (`rows.rs`), the first triangle's first; none where
+    /// the polygon is cut by its own points alone.
+    pub interior: Vec<RowPoint>,
+}
+
+impl Pair {
+    /// How many of the interior points are triangle `side`'s (0 or 1) own.
+    pub(crate) fn interior_of(&self, side: usize) -> usize {
+        self.interior
+            .iter()
+            .filter(|p| usize::from(p.side) == side)
+            .count()
+    }
+
+    /// How many of [`Pair::triangles`] triangle `side` writes, when its pattern alone (the
+    /// polygon of its edge samples) would have `own` triangles: two more per interior point.
+    pub(crate) fn share_len(&self, side: usize, own: usize) -> usize {
+        own + 2 * self.interior_of(side)
+    }
+
+    /// Where point `q` of [`Pair::triangles`] lies: which triangle and its barycentrics there,
+    /// `joined` being the joined polygon of `patterns`.
+    pub(crate) fn point_bary(
+        &self,
+        joined: &[JoinedPoint],
+        patterns: [&Pattern; 2],
+        q: u8,
+    ) -> (usize, [f64; 3]) {
+        let q = usize::from(q);
+        match joined.get(q) {
+            Some(&(s, p)) => (s, patterns[s].bary(p)),
+            None => {
+                let r = self.interior[q - joined.len()];
+                (usize::from(r.side), r.bary())
+            }
+        }
+    }
 }
 
 /// A point of the joined polygon: which triangle of the pair (0 or 1) and its point in that
 /// triangle's pattern.
-type JoinedPoint = (usize, u32);
+pub(crate) type JoinedPoint = (usize, u32);
 
 /// The joined polygon of `pair` cut by `patterns` (each with one segment on the shared edge),
 /// counter-clockwise in the first triangle's winding: the first triangle's polygon from the end
@@ -106,14 +145,14 @@ pub(crate) fn joined_polygon(sides: [u8; 2], patterns: [&Pattern; 2]) -> Vec<Joi
 }
 
 /// The two triangles of a pair laid flat side by side (see the module docs).
-struct Chart {
+pub(super) struct Chart {
     /// Each triangle's corners on the chart, in its own corner order.
     corners: [[DVec2; 3]; 2],
 }
 
 impl Chart {
     /// The chart of triangles `tris`, sharing their edges `sides`, from the welded positions.
-    fn new(topo: &Topology, tris: [usize; 2], sides: [u8; 2]) -> Chart {
+    pub(super) fn new(topo: &Topology, tris: [usize; 2], sides: [u8; 2]) -> Chart {
         let at = |t: usize, c: usize| topo.welded_positions[topo.tri_verts[t][c].0 as usize];
         let mut corners = [[DVec2::ZERO; 3]; 2];
         for (s, &t) in tris.iter().enumerate() {
@@ -137,14 +176,14 @@ impl Chart {
     }
 
     /// Where point `bary` of triangle `s` of the pair lies on the chart.
-    fn place(&self, s: usize, bary: [f64; 3]) -> DVec2 {
+    pub(super) fn place(&self, s: usize, bary: [f64; 3]) -> DVec2 {
         let c = &self.corners[s];
         bary[0] * c[0] + bary[1] * c[1] + bary[2] * c[2]
     }
 
     /// Which triangle of the pair (0 or 1) holds chart point `q`, and its barycentrics there:
     /// the first where it holds `q` (up to rounding), else the second, clamped to it.
-    fn locate(&self, q: DVec2) -> (usize, [f64; 3]) {
+    pub(super) fn locate(&self, q: DVec2) -> (usize, [f64; 3]) {
         let bary_in = |c: &[DVec2; 3]| {
             let (u, v, w) = (c[1] - c[0], c[2] - c[0], q - c[0]);
             let det = u.perp_dot(v);
@@ -169,13 +208,13 @@ fn normalized(b: [f64; 3]) -> [f64; 3] {
 
 /// Evaluates points of either triangle of a pair: `(s, barys, out)` appends the points of
 /// triangle `s` of the pair at `barys` to `out`.
-type OnBoth<'a> = dyn FnMut(usize, &[[f64; 3]], &mut Vec<SurfacePoint>) + 'a;
+pub(super) type OnBoth<'a> = dyn FnMut(usize, &[[f64; 3]], &mut Vec<SurfacePoint>) + 'a;
 
 /// Calls `f` with an evaluator of both triangles `tris` that sets each up once for all its
 /// calls ([`Surface::evaluate_points_on_demand`]), where one evaluation per sample set the
 /// patch up for each (on the 10k torus at 1e-3 the pass took 844M instructions that way, 669M
 /// this way).
-fn with_both<R>(
+pub(super) fn with_both<R>(
     surface: &dyn Surface,
     tris: [usize; 2],
     f: impl FnOnce(&mut OnBoth<'_>) -> R,
@@ -200,16 +239,30 @@ fn with_both<R>(
 
 /// Scratch buffers of [`joined_triangle_error`].
 #[derive(Debug, Default)]
-struct JoinedSamples {
+pub(super) struct JoinedSamples {
     barys: [Vec<[f64; 3]>; 2],
     points: [Vec<SurfacePoint>; 2],
+}
+
+impl JoinedSamples {
+    /// The points of triangle `s` of a pair at `barys`, evaluated by `both` into this scratch.
+    pub(super) fn evaluate(
+        &mut self,
+        both: &mut OnBoth<'_>,
+        s: usize,
+        barys: &[[f64; 3]],
+    ) -> &[SurfacePoint] {
+        self.points[s].clear();
+        both(s, barys, &mut self.points[s]);
+        &self.points[s]
+    }
 }
 
 /// The chord error of the output triangle with corners at chart points `chart` and written
 /// positions `flat`: the largest distance of its [`WEIGHTS`] samples from the surface's tangent
 /// plane at the surface point under each, found through `on_chart` and evaluated by `both`,
 /// each triangle's samples in one call.
-fn joined_triangle_error(
+pub(super) fn joined_triangle_error(
     both: &mut OnBoth<'_>,
     on_chart: &Chart,
     chart: [DVec2; 3],
@@ -263,8 +316,8 @@ pub(crate) fn joined_error(
         let mut worst = 0.0f64;
         for (u, t) in pair.triangles.iter().enumerate() {
             let on_chart = t.map(|q| {
-                let (s, p) = joined[usize::from(q)];
-                chart.place(s, patterns[s].bary(p))
+                let (s, bary) = pair.point_bary(&joined, patterns, q);
+                chart.place(s, bary)
             });
             let flat = [0, 1, 2].map(|c| corner(u, c));
             worst = worst.max(joined_triangle_error(
@@ -298,52 +351,14 @@ impl SegmentCounts {
         groups: &[Range<usize>],
     ) {
         let counts = self;
-        let mut group_of = vec![u32::MAX; counts.inner.len()];
-        for (g, range) in groups.iter().enumerate() {
-            group_of[range.clone()]
-                .iter_mut()
-                .for_each(|x| *x = g as u32);
-        }
-        // Per edge that could be dissolved: the edge, its triangles, their sides on it, and their
-        // pattern keys with one segment there.
+        let group_of = group_table(counts.inner.len(), groups);
         let candidates: Vec<Candidate> = (0..topo.edge_count())
             .into_par_iter()
             .filter_map(|e| {
-                let id = EdgeId(e as u32);
-                if counts.edges[e] < 2
-                    || topo.edge_kind(id) != EdgeKind::Interior
-                    || is_crease(topo, h, id)
-                {
-                    return None;
-                }
-                // An interior edge has two distinct triangles, the lower-numbered first.
-                let uses = topo.edge_uses(id);
-                let [(t0, k0), (t1, k1)] = [uses[0].at(), uses[1].at()];
-                if group_of[t0] != group_of[t1] || group_of[t0] == u32::MAX {
-                    return None;
-                }
-                // The same input vertices, the second triangle running the edge the other way.
-                let ends = |t: usize, k: usize| {
-                    let v = mesh.triangles[t];
-                    (v[(k + 1) % 3], v[(k + 2) % 3])
-                };
-                let ((a0, b0), (a1, b1)) = (ends(t0, k0), ends(t1, k1));
-                if (a0, b0) != (b1, a1) {
-                    return None;
-                }
-                let keys = [(t0, k0), (t1, k1)].map(|(t, k)| {
-                    let mut key = counts.key(topo, t);
-                    key.edges[k] = 1;
-                    key.fill = 0;
-                    key
-                });
+                let (tris, sides) = dissolvable(counts, mesh, topo, h, &group_of, e)?;
+                let keys = one_segment_keys(counts, topo, tris, sides);
                 // Without interior points on both sides, one segment or not.
-                (keys[0].inner <= 2 && keys[1].inner <= 2).then_some((
-                    e,
-                    [t0, t1],
-                    [k0 as u8, k1 as u8],
-                    keys,
-                ))
+                (keys[0].inner <= 2 && keys[1].inner <= 2).then_some((e, tris, sides, keys))
             })
             .collect();
         let found: Vec<Option<Pair>> = candidates
@@ -379,11 +394,68 @@ impl SegmentCounts {
     }
 }
 
+/// Per source triangle, the index of its output group in `groups` (`u32::MAX`: none).
+pub(super) fn group_table(triangles: usize, groups: &[Range<usize>]) -> Vec<u32> {
+    let mut group_of = vec![u32::MAX; triangles];
+    for (g, range) in groups.iter().enumerate() {
+        group_of[range.clone()]
+            .iter_mut()
+            .for_each(|x| *x = g as u32);
+    }
+    group_of
+}
+
+/// The two triangles of edge `e` and their sides on it, the lower-numbered first, where the
+/// edge could be dissolved (the module docs say when): an interior smooth edge with more than
+/// one segment, within one group, with the same input vertices on both sides, wound alike.
+pub(super) fn dissolvable(
+    counts: &SegmentCounts,
+    mesh: &TriMesh,
+    topo: &Topology,
+    h: &[f64],
+    group_of: &[u32],
+    e: usize,
+) -> Option<([usize; 2], [u8; 2])> {
+    let id = EdgeId(e as u32);
+    if counts.edges[e] < 2 || topo.edge_kind(id) != EdgeKind::Interior || is_crease(topo, h, id) {
+        return None;
+    }
+    // An interior edge has two distinct triangles, the lower-numbered first.
+    let uses = topo.edge_uses(id);
+    let [(t0, k0), (t1, k1)] = [uses[0].at(), uses[1].at()];
+    if group_of[t0] != group_of[t1] || group_of[t0] == u32::MAX {
+        return None;
+    }
+    // The same input vertices, the second triangle running the edge the other way.
+    let ends = |t: usize, k: usize| {
+        let v = mesh.triangles[t];
+        (v[(k + 1) % 3], v[(k + 2) % 3])
+    };
+    let ((a0, b0), (a1, b1)) = (ends(t0, k0), ends(t1, k1));
+    ((a0, b0) == (b1, a1)).then_some(([t0, t1], [k0 as u8, k1 as u8]))
+}
+
+/// The pattern keys of triangles `tris` with one segment on their sides `sides`, filled by
+/// ears (what [`joined_polygon`] reads their edge samples from).
+pub(super) fn one_segment_keys(
+    counts: &SegmentCounts,
+    topo: &Topology,
+    tris: [usize; 2],
+    sides: [u8; 2],
+) -> [PatternKey; 2] {
+    [0, 1].map(|s| {
+        let mut key = counts.key(topo, tris[s]);
+        key.edges[usize::from(sides[s])] = 1;
+        key.fill = 0;
+        key
+    })
+}
+
 /// Whether the chart triangle `t` is wound counter-clockwise with every angle at least
 /// [`ANGLE_FLOOR`]: an angle `θ` between sides `u` and `v` is at least the floor where
 /// `u·v ≤ 0` or `|u × v| ≥ tan(floor)·(u·v)`, without the three arctangents of `transition.rs`'s `min_angle`
 /// (on the 10k icosphere at 3e-4 they were a quarter of the pass).
-fn keeps_floor(t: [DVec2; 3]) -> bool {
+pub(super) fn keeps_floor(t: [DVec2; 3]) -> bool {
     let tan_floor = ANGLE_FLOOR.tan();
     (t[1] - t[0]).perp_dot(t[2] - t[0]) > 0.0
         && (0..3).all(|c| {
@@ -395,7 +467,7 @@ fn keeps_floor(t: [DVec2; 3]) -> bool {
 
 /// Writes into `position` the points of the joined polygon `joined` (of triangles cut by
 /// `patterns`) that are `needed`, as the output writes them, each triangle's in one call.
-fn polygon_points(
+pub(super) fn polygon_points(
     both: &mut OnBoth<'_>,
     scratch: &mut JoinedSamples,
     joined: &[JoinedPoint],
@@ -579,6 +651,7 @@ fn joined_fill(
             tris: tris.map(|t| t as u32),
             sides,
             triangles,
+            interior: Vec::new(),
         })
     })
 }
