@@ -375,22 +375,46 @@ impl SegmentCounts {
             .filter(|&c| found[c].is_some())
             .collect();
         order.sort_by_key(|&c| (std::cmp::Reverse(counts.edges[candidates[c].0]), c));
+        counts.pairs.clear();
         let mut taken = vec![false; counts.inner.len()];
-        let mut pairs = Vec::new();
-        for c in order {
-            let (e, tris, _, _) = candidates[c];
+        counts.take_pairs(
+            &order,
+            |c| (candidates[c].0, candidates[c].1),
+            &found,
+            &mut taken,
+            false,
+        );
+    }
+
+    /// Cuts the pairs `found[c]` of the candidates `c` in `order` (edge and triangles
+    /// `candidate(c)`) whose triangles are not `taken` yet, and marks them taken: the edge
+    /// takes one segment, the triangles the fill by ears, and for quads cut in rows
+    /// (`in_rows`, `rows.rs`) inner level 1: their interior is the rows' points, if any.
+    pub(super) fn take_pairs(
+        &mut self,
+        order: &[usize],
+        candidate: impl Fn(usize) -> (usize, [usize; 2]),
+        found: &[Option<Pair>],
+        taken: &mut [bool],
+        in_rows: bool,
+    ) {
+        for &c in order {
+            let (e, tris) = candidate(c);
             if tris.iter().any(|&t| taken[t]) {
                 continue;
             }
+            let pair = found[c].clone().expect("only those found");
             tris.iter().for_each(|&t| taken[t] = true);
-            counts.edges[e] = 1;
+            self.edges[e] = 1;
             for &t in &tris {
-                counts.fill[t] = 0;
+                self.fill[t] = 0;
+                if in_rows {
+                    self.inner[t] = 1;
+                }
             }
-            pairs.push(found[c].clone().expect("only those found"));
+            self.pairs.push(pair);
         }
-        pairs.sort_by_key(|p| p.tris[0]);
-        counts.pairs = pairs;
+        self.pairs.sort_by_key(|p| p.tris[0]);
     }
 }
 

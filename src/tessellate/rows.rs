@@ -177,22 +177,13 @@ impl SegmentCounts {
             .filter(|&c| found[c].is_some())
             .collect();
         order.sort_by_key(|&c| (std::cmp::Reverse(saved[c]), c));
-        for c in order {
-            let (e, tris, _, _, _) = candidates[c];
-            if tris.iter().any(|&t| taken[t]) {
-                continue;
-            }
-            tris.iter().for_each(|&t| taken[t] = true);
-            counts.edges[e] = 1;
-            for &t in &tris {
-                counts.inner[t] = 1;
-                counts.fill[t] = 0;
-            }
-            counts
-                .pairs
-                .push(found[c].clone().expect("only those found"));
-        }
-        counts.pairs.sort_by_key(|p| p.tris[0]);
+        counts.take_pairs(
+            &order,
+            |c| (candidates[c].0, candidates[c].1),
+            &found,
+            &mut taken,
+            true,
+        );
     }
 }
 
