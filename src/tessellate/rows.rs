@@ -144,7 +144,7 @@ impl SegmentCounts {
                 };
                 let [c0, c1, c2, c3] = [count(0, 1), count(0, 2), count(1, 1), count(1, 2)];
                 let worth = |a: usize, other: usize, b: [usize; 2]| {
-                    a == other && a >= 2 && worth_trying(now, a, b[0].min(b[1]))
+                    a == other && a >= 2 && worth_trying(now, a, b)
                 };
                 if !worth(c0, c2, [c1, c3]) && !worth(c1, c3, [c0, c2]) {
                     return None;
@@ -194,15 +194,21 @@ type StripKey = (usize, RowKind, RowKind);
 const COARSE_QUAD: u64 = 64;
 
 /// Whether a quad of `now` triangles as they are is worth trying in rows whose ends have `a`
-/// segments and whose first and last rows have `b` or more: where it is coarse
-/// ([`COARSE_QUAD`]), or where the sides across the rows have at most two thirds of the
-/// segments of the rows' ends, as across a torus's tube. Elsewhere the patterns are fine and
-/// the curvature about the same every way, and rows save little for their cost: on the 10k
-/// icosphere at 1e-5, 2% of the triangles for 1.7 times the run's time, at the error level
-/// 16 reaches 1.2% for 5 times.
-fn worth_trying(now: u64, a: usize, b: usize) -> bool {
-    now <= COARSE_QUAD || 3 * b <= 2 * a
+/// segments and whose first and last rows have `b` segments: where the fewest rows possible
+/// (one segment each) would save at least [`LEAST_SAVING`] triangles, and where the quad is
+/// coarse ([`COARSE_QUAD`]) or the sides across the rows have at most two thirds of the
+/// segments of the rows' ends, as across a torus's tube. Elsewhere rows save little for their
+/// cost: on the 10k icosphere at 3e-4 (quads of 7 or 8 triangles) they found nothing for 1.6
+/// times the run's instructions; at 1e-5 (fine patterns, the curvature the same every way),
+/// 2% of the triangles for 1.7 times its time, at the error level 16 reaches 1.2% for 5
+/// times.
+fn worth_trying(now: u64, a: usize, b: [usize; 2]) -> bool {
+    let fewest = (b[0] + b[1] + 2 * (a - 1)) as u64;
+    now >= fewest + LEAST_SAVING && (now <= COARSE_QUAD || 3 * b[0].min(b[1]) <= 2 * a)
 }
+
+/// See [`worth_trying`].
+const LEAST_SAVING: u64 = 4;
 
 /// The quad's points: the joined polygon's first, then the inner points of every row made so
 /// far; each on the chart and as written.
@@ -508,7 +514,7 @@ fn rows_fill(
             if ends[1].len() - 1 != a || a < 2 {
                 continue;
             }
-            if !worth_trying(now, a, first.len().min(last.len()) - 1) {
+            if !worth_trying(now, a, [first.len() - 1, last.len() - 1]) {
                 continue;
             }
             let fixed = (first.len() - 1 + last.len() - 1) as u64;
@@ -595,4 +601,66 @@ fn rows_fill(
             interior: used.iter().map(|&q| points.inner[q - n]).collect(),
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_are_sampled_evenly_or_shifted_by_half_a_segment() {
+        let close = |a: Vec<f64>, b: &[f64]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-15)
+        };
+        let aligned = RowKind::Inner {
+            m: 3,
+            shifted: false,
+        };
+        let shifted = RowKind::Inner {
+            m: 3,
+            shifted: true,
+        };
+        assert!(close(aligned.stations().collect(), &[1.0 / 3.0, 2.0 / 3.0]));
+        assert!(close(
+            shifted.stations().collect(),
+            &[1.0 / 6.0, 0.5, 5.0 / 6.0]
+        ));
+        assert_eq!(RowKind::Side.stations().count(), 0);
+    }
+
+    #[test]
+    fn a_point_is_rounded_to_the_nearest_lattice_point_of_its_triangle() {
+        let step = 1.0 / f64::from(ROW_LEVEL);
+        for k in 0..2000 {
+            // Points spread over the triangle, corners and edges included.
+            let (u, v) = ((k % 53) as f64 / 52.0, (k / 53) as f64 / 37.0);
+            let bary = [(1.0 - u) * (1.0 - v), u * (1.0 - v), v];
+            let p = RowPoint::rounded(1, bary);
+            assert_eq!(p.side, 1);
+            assert!(u32::from(p.i) + u32::from(p.j) <= ROW_LEVEL, "{bary:?}");
+            let b = p.bary();
+            assert!(
+                (b[1] - bary[1]).abs() <= step / 2.0 + 1e-12,
+                "{bary:?} {b:?}"
+            );
+            assert!(
+                (b[2] - bary[2]).abs() <= step / 2.0 + 1e-12,
+                "{bary:?} {b:?}"
+            );
+            // A lattice point is its own rounding.
+            assert_eq!(RowPoint::rounded(1, b), p);
+        }
+    }
+
+    #[test]
+    fn only_quads_rows_could_save_on_are_tried() {
+        // A torus quad at 1e-4: 29 triangles, four segments across the tube, two along it.
+        assert!(worth_trying(29, 4, [2, 2]));
+        // A quad of 7 triangles that the fewest rows (6) would save one on.
+        assert!(!worth_trying(7, 2, [2, 2]));
+        // Fine and about as fine every way: an icosphere's quad at 1e-5.
+        assert!(!worth_trying(118, 8, [8, 7]));
+        // Fine but far coarser along the rows than across them.
+        assert!(worth_trying(120, 8, [4, 5]));
+    }
 }
