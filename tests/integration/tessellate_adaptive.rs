@@ -468,6 +468,41 @@ fn a_quad_torus_is_cut_in_rows_across_the_tube_within_the_tolerance() {
 }
 
 #[test]
+fn a_quad_torus_with_its_diagonals_one_way_is_cut_in_rows_watertight() {
+    // The same torus with every quad split the same way, as `gen_mesh.py` writes it: there
+    // some quads are cut in rows of one segment, with no point inside, whose triangles must
+    // still leave their own interior (a first form of the cut kept it and could not write them).
+    let mut mesh = torus_rings(125, 40, 0.35);
+    let id = |i: usize, j: usize| ((j % 40) * 125 + (i % 125)) as u32;
+    mesh.triangles = (0..40)
+        .flat_map(|j| (0..125).map(move |i| (i, j)))
+        .flat_map(|(i, j)| {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            [[a, b, c], [a, c, d]]
+        })
+        .collect();
+    let tolerance = 1e-4;
+    let r = run(&mesh, 0.2, tolerance, 64);
+    let triangles = r.dense.indices.len() / 3;
+    // No pattern is without interior points here, so every pair is a quad cut in rows.
+    let pairs = &r.counts.pairs;
+    assert!(pairs
+        .iter()
+        .all(|p| p.tris.iter().all(|&t| r.counts.inner[t as usize] == 1)));
+    let without_points = pairs.iter().filter(|p| p.interior.is_empty()).count();
+    println!(
+        "one-way torus at {tolerance:e}: {triangles} triangles, {} quads in rows, {without_points} without points inside, measured {:.3e}",
+        pairs.len(),
+        r.measured
+    );
+    assert!(without_points > 0, "no quad in rows of one segment");
+    assert_eq!(triangles as u64, r.counts.triangle_count(&r.topo));
+    assert!(triangles <= 95_000, "{triangles} triangles");
+    assert!(r.measured <= tolerance, "{}", r.measured);
+    assert_eq!(boundary_edges(&r.dense.positions, &r.dense.indices), 0);
+}
+
+#[test]
 fn creases_and_seams_are_not_dissolved() {
     // The same torus with every edge a crease (h = 0), and with every vertex split per
     // triangle (split normals): no two triangles are cut as one, at the tolerance where the
