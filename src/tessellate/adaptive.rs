@@ -28,7 +28,7 @@ use super::rows::ROW_LEVEL;
 use super::transition::{Pattern, PatternKey};
 use super::{DenseMesh, VertexSource, BLOCK_TRIANGLES};
 use crate::mesh::TriMesh;
-use crate::surface::{LatticePart, Surface};
+use crate::surface::{LatticePart, Surface, SurfacePoint};
 use crate::topology::Topology;
 
 /// Tessellates `groups` of `mesh` with `counts`; `h` as for [`super::tessellate`].
@@ -195,8 +195,7 @@ fn tessellate_block(
     let mut writer = emit::TriangleWriter::new(mesh, topo, surface);
     let mut local: Vec<u32> = Vec::new();
     let mut parts = Vec::with_capacity(4);
-    let mut barys = Vec::new();
-    let mut evaluated = Vec::new();
+    let mut scratch = (Vec::new(), Vec::new());
     for offset in block.tris.clone() {
         let tri = first_tri + offset;
         let pattern = shared.pattern(tri);
@@ -274,34 +273,52 @@ fn tessellate_block(
         );
         match shared.counts.pair_of(shared.pair_table, tri) {
             Some((pair, side)) => {
-                let own = pair.interior.iter().filter(|p| usize::from(p.side) == side);
-                if own.clone().next().is_some() {
-                    // The points inside a quad cut in rows (`rows.rs`) that are this triangle's,
-                    // after its pattern's (it has none): lattice points of their own level.
-                    barys.clear();
-                    barys.extend(own.clone().map(|p| p.bary()));
-                    evaluated.clear();
-                    surface.evaluate_points(tri, &barys, &mut evaluated);
-                    let first_slot = layout.base[offset + 1] as usize - evaluated.len();
-                    for (rank, (p, at)) in own.zip(&evaluated).enumerate() {
-                        block.put(
-                            first_slot + rank,
-                            at.position.as_vec3().to_array(),
-                            at.normal.as_vec3().to_array(),
-                            VertexSource::lattice(
-                                tri as u32,
-                                ROW_LEVEL,
-                                u32::from(p.i),
-                                u32::from(p.j),
-                            ),
-                        );
-                    }
-                }
+                let first_slot = layout.base[offset + 1] as usize - pair.interior_of(side);
+                write_row_points(
+                    surface,
+                    tri,
+                    pair,
+                    side,
+                    first_slot,
+                    &mut block,
+                    &mut scratch,
+                );
                 let out = &mut block.indices[start..end];
                 write_share(shared, layout, first_tri, pair, side, out)
             }
             None => emit::triangles(&mut block.indices[start..end], &pattern.triangles, &local),
         }
+    }
+}
+
+/// Writes the points inside `pair` (a quad cut in rows, `rows.rs`) that are its triangle
+/// `side`'s (source triangle `tri`) into the interior slots from `first_slot` on (its pattern
+/// has none): lattice points of their own level, evaluated in one call.
+fn write_row_points(
+    surface: &dyn Surface,
+    tri: usize,
+    pair: &Pair,
+    side: usize,
+    first_slot: usize,
+    block: &mut Block<'_>,
+    (barys, evaluated): &mut (Vec<[f64; 3]>, Vec<SurfacePoint>),
+) {
+    let own = pair.interior.iter().filter(|p| usize::from(p.side) == side);
+    barys.clear();
+    barys.extend(own.clone().map(|p| p.bary()));
+    if barys.is_empty() {
+        return;
+    }
+    evaluated.clear();
+    surface.evaluate_points(tri, barys, evaluated);
+    for (rank, (p, at)) in own.zip(evaluated.iter()).enumerate() {
+        let source = VertexSource::lattice(tri as u32, ROW_LEVEL, u32::from(p.i), u32::from(p.j));
+        block.put(
+            first_slot + rank,
+            at.position.as_vec3().to_array(),
+            at.normal.as_vec3().to_array(),
+            source,
+        );
     }
 }
 
@@ -326,18 +343,16 @@ fn write_share(
         &pair.triangles[first_share..]
     };
     let n = joined.len();
+    // A point inside (`rows.rs`) is the first triangle's or the second's, the first's listed
+    // first, and its triangle's interior slots are its points, in that order.
+    let own = [pair.interior_of(0), pair.interior_of(1)];
     let slot = |q: u8| {
         let Some(&(s, p)) = joined.get(usize::from(q)) else {
-            // A point inside (`rows.rs`): its triangle's interior slots are its points, the
-            // first triangle's first.
             let r = usize::from(q) - n;
             let s = usize::from(pair.interior[r].side);
-            let (before, own) = (
-                if s == 1 { pair.interior_of(0) } else { 0 },
-                pair.interior_of(s),
-            );
+            let rank = r - if s == 1 { own[0] } else { 0 };
             let offset = tris[s] - first_tri;
-            return layout.base[offset + 1] - (own - (r - before)) as u32;
+            return layout.base[offset + 1] - (own[s] - rank) as u32;
         };
         point_slot(
             layout,

@@ -63,6 +63,43 @@ use crate::surface::{Surface, SurfacePoint};
 use crate::topology::{EdgeId, EdgeKind, Topology};
 use std::ops::Range;
 
+/// The joined polygon of two triangles laid on their chart.
+pub(super) struct JoinedChart {
+    /// The two triangles' patterns, each with one segment on the shared edge.
+    pub patterns: [Kept<Pattern>; 2],
+    /// The polygon's points ([`joined_polygon`]).
+    pub points: Vec<JoinedPoint>,
+    /// The chart of the two triangles.
+    pub chart: Chart,
+    /// Where each point lies on it.
+    pub on_chart: Vec<DVec2>,
+}
+
+impl JoinedChart {
+    /// The joined polygon of triangles `tris` cut by `keys` (one segment on their shared
+    /// sides `sides`), on the chart of the two.
+    pub(super) fn new(
+        topo: &Topology,
+        tris: [usize; 2],
+        sides: [u8; 2],
+        keys: [PatternKey; 2],
+    ) -> JoinedChart {
+        let patterns = keys.map(kept_patterns::pattern);
+        let points = joined_polygon(sides, [&patterns[0], &patterns[1]]);
+        let chart = Chart::new(topo, tris, sides);
+        let on_chart = points
+            .iter()
+            .map(|&(s, p)| chart.place(s, patterns[s].bary(p)))
+            .collect();
+        JoinedChart {
+            patterns,
+            points,
+            chart,
+            on_chart,
+        }
+    }
+}
+
 /// Two source triangles whose shared edge is dissolved into one polygon.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Pair {
@@ -539,17 +576,16 @@ fn joined_fill(
     tolerance: f64,
     scratch: &mut JoinedSamples,
 ) -> Option<Pair> {
-    let patterns = keys.map(kept_patterns::pattern);
-    let joined = joined_polygon(sides, [&patterns[0], &patterns[1]]);
+    let JoinedChart {
+        patterns,
+        points: joined,
+        chart,
+        on_chart,
+    } = JoinedChart::new(topo, tris, sides, keys);
     let n = joined.len();
     if n > u8::MAX as usize {
         return None;
     }
-    let chart = Chart::new(topo, tris, sides);
-    let on_chart: Vec<DVec2> = joined
-        .iter()
-        .map(|&(s, p)| chart.place(s, patterns[s].bary(p)))
-        .collect();
     // The candidate triangle lo < k < hi, if wound the right way and keeping the floor.
     let keeps =
         |lo: usize, k: usize, hi: usize| keeps_floor([on_chart[lo], on_chart[k], on_chart[hi]]);

@@ -52,10 +52,9 @@ use rayon::prelude::*;
 
 use super::chord::{angle_in_space, written};
 use super::counts::SegmentCounts;
-use super::kept_patterns;
 use super::pairs::{
-    dissolvable, group_table, joined_polygon, joined_triangle_error, keeps_floor, one_segment_keys,
-    polygon_points, with_both, Chart, JoinedSamples, OnBoth, Pair,
+    dissolvable, group_table, joined_triangle_error, keeps_floor, one_segment_keys, polygon_points,
+    with_both, Chart, JoinedChart, JoinedSamples, OnBoth, Pair,
 };
 use super::transition::PatternKey;
 use crate::mesh::TriMesh;
@@ -98,9 +97,19 @@ impl RowPoint {
     }
 }
 
-/// An edge whose quad could be cut in rows: the edge, its two triangles, their sides on it,
-/// their keys with one segment there and no interior, and the triangles they have now.
-type Candidate = (usize, [usize; 2], [u8; 2], [PatternKey; 2], u64);
+/// An edge whose quad could be cut in rows.
+struct Candidate {
+    edge: usize,
+    /// Its two triangles and their sides on it.
+    tris: [usize; 2],
+    sides: [u8; 2],
+    /// Their keys with one segment on it and no interior.
+    keys: [PatternKey; 2],
+    /// The triangles they have now.
+    now: u64,
+    /// Which orientations of the quad (`rows_fill`) are worth trying ([`worth_trying`]).
+    orientations: [bool; 2],
+}
 
 impl SegmentCounts {
     /// Cuts in rows (see the module docs) the quads of the edges `pairs.rs` could dissolve but
@@ -146,30 +155,33 @@ impl SegmentCounts {
                 let worth = |a: usize, other: usize, b: [usize; 2]| {
                     a == other && a >= 2 && worth_trying(now, a, b)
                 };
-                if !worth(c0, c2, [c1, c3]) && !worth(c1, c3, [c0, c2]) {
+                let orientations = [worth(c0, c2, [c1, c3]), worth(c1, c3, [c0, c2])];
+                if orientations == [false, false] {
                     return None;
                 }
                 let mut keys = one_segment_keys(counts, topo, tris, sides);
                 keys.iter_mut().for_each(|k| k.inner = 1);
-                Some((e, tris, sides, keys, now))
+                Some(Candidate {
+                    edge: e,
+                    tris,
+                    sides,
+                    keys,
+                    now,
+                    orientations,
+                })
             })
             .collect();
         let found: Vec<Option<Pair>> = candidates
             .par_iter()
-            .map_init(
-                JoinedSamples::default,
-                |scratch, &(_, tris, sides, keys, now)| {
-                    rows_fill(
-                        surface, topo, tris, sides, keys, now, tolerance, cap, scratch,
-                    )
-                },
-            )
+            .map_init(JoinedSamples::default, |scratch, candidate| {
+                rows_fill(surface, topo, candidate, tolerance, cap, scratch)
+            })
             .collect();
         let saved: Vec<u64> = (0..candidates.len())
             .map(|c| {
                 found[c]
                     .as_ref()
-                    .map_or(0, |pair| candidates[c].4 - pair.triangles.len() as u64)
+                    .map_or(0, |pair| candidates[c].now - pair.triangles.len() as u64)
             })
             .collect();
         // Most triangles saved first, then by candidate; each triangle in one cut at most.
@@ -179,7 +191,7 @@ impl SegmentCounts {
         order.sort_by_key(|&c| (std::cmp::Reverse(saved[c]), c));
         counts.take_pairs(
             &order,
-            |c| (candidates[c].0, candidates[c].1),
+            |c| (candidates[c].edge, candidates[c].tris),
             &found,
             &mut taken,
             true,
@@ -229,23 +241,18 @@ enum RowKind {
     Inner { m: u32, shifted: bool },
 }
 
-impl RowKind {
-    /// Where the inner points of an inner row lie along it, as fractions of its length.
-    fn stations(self) -> impl Iterator<Item = f64> {
-        let (m, shifted) = match self {
-            RowKind::Side => (1, false),
-            RowKind::Inner { m, shifted } => (m, shifted),
-        };
-        let count = if shifted { m } else { m - 1 };
-        (1..=count).map(move |j| {
-            let j = f64::from(j);
-            if shifted {
-                (j - 0.5) / f64::from(m)
-            } else {
-                j / f64::from(m)
-            }
-        })
-    }
+/// Where the inner points of a row of `m` segments lie along it, as fractions of its length;
+/// `shifted`, the row shifted by half a segment (`m + 1` segments, half ones at its ends).
+fn stations(m: u32, shifted: bool) -> impl Iterator<Item = f64> {
+    let count = if shifted { m } else { m - 1 };
+    (1..=count).map(move |j| {
+        let j = f64::from(j);
+        if shifted {
+            (j - 0.5) / f64::from(m)
+        } else {
+            j / f64::from(m)
+        }
+    })
 }
 
 /// One orientation of a quad being cut in rows: its rows' ends and sides, and the rows and
@@ -289,13 +296,13 @@ impl Quad<'_> {
         let row = match kind {
             RowKind::Side if i == 0 => self.first.clone(),
             RowKind::Side => self.last.clone(),
-            RowKind::Inner { .. } => {
+            RowKind::Inner { m, shifted } => {
                 let (from, to) = (
                     self.points.chart[self.ends[0][i]],
                     self.points.chart[self.ends[1][i]],
                 );
                 let mut row = vec![self.ends[0][i]];
-                for fraction in kind.stations() {
+                for fraction in stations(m, shifted) {
                     let (s, bary) = self.chart.locate(from.lerp(to, fraction));
                     let point = RowPoint::rounded(s, bary);
                     row.push(self.points.chart.len());
@@ -449,35 +456,39 @@ impl Quad<'_> {
     }
 }
 
-/// The quad of `tris` (cut by `keys`, one segment on their shared sides `sides`, `now`
-/// triangles as they are) cut in rows within `tolerance` with fewer than `now` triangles, the
-/// fewest of either orientation (the first on a tie); `None` if there is none.
-#[allow(clippy::too_many_arguments)]
+/// The quad of `candidate` cut in rows within `tolerance`, at most `cap` segments a row, with
+/// fewer triangles than it has now, the fewest of the orientations worth trying (the first on
+/// a tie); `None` if there is none.
 fn rows_fill(
     surface: &dyn Surface,
     topo: &Topology,
-    tris: [usize; 2],
-    sides: [u8; 2],
-    keys: [PatternKey; 2],
-    now: u64,
+    candidate: &Candidate,
     tolerance: f64,
     cap: u32,
     scratch: &mut JoinedSamples,
 ) -> Option<Pair> {
-    let patterns = keys.map(kept_patterns::pattern);
-    let joined = joined_polygon(sides, [&patterns[0], &patterns[1]]);
+    let &Candidate {
+        tris,
+        sides,
+        keys,
+        now,
+        orientations,
+        ..
+    } = candidate;
+    let JoinedChart {
+        patterns,
+        points: joined,
+        chart,
+        on_chart,
+    } = JoinedChart::new(topo, tris, sides, keys);
     let n = joined.len();
     let corners: Vec<usize> = (0..n).filter(|&i| joined[i].1 < 3).collect();
     if corners.len() != 4 || corners[0] != 0 {
         return None;
     }
-    let chart = Chart::new(topo, tris, sides);
     with_both(surface, tris, |both| {
         let mut polygon = QuadPoints {
-            chart: joined
-                .iter()
-                .map(|&(s, p)| chart.place(s, patterns[s].bary(p)))
-                .collect(),
+            chart: on_chart,
             position: vec![DVec3::NAN; n],
             inner: Vec::new(),
         };
@@ -502,7 +513,7 @@ fn rows_fill(
             v
         };
         let mut best: Option<(Vec<[usize; 3]>, QuadPoints)> = None;
-        for orientation in 0..2 {
+        for orientation in (0..2).filter(|&o| orientations[o]) {
             // The rows' ends (from row 0 to row a) and the first and last rows (from the
             // first end to the second).
             let (ends, first, last) = if orientation == 0 {
@@ -511,12 +522,7 @@ fn rows_fill(
                 ([side(1), reversed(side(3))], reversed(side(0)), side(2))
             };
             let a = ends[0].len() - 1;
-            if ends[1].len() - 1 != a || a < 2 {
-                continue;
-            }
-            if !worth_trying(now, a, [first.len() - 1, last.len() - 1]) {
-                continue;
-            }
+            debug_assert!(ends[1].len() - 1 == a && a >= 2, "rows' ends of one count");
             let fixed = (first.len() - 1 + last.len() - 1) as u64;
             let mut limit = best.as_ref().map_or(now, |b| b.0.len() as u64);
             let mut quad = Quad {
@@ -612,20 +618,13 @@ mod tests {
         let close = |a: Vec<f64>, b: &[f64]| {
             a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-15)
         };
-        let aligned = RowKind::Inner {
-            m: 3,
-            shifted: false,
-        };
-        let shifted = RowKind::Inner {
-            m: 3,
-            shifted: true,
-        };
-        assert!(close(aligned.stations().collect(), &[1.0 / 3.0, 2.0 / 3.0]));
+        assert!(close(stations(3, false).collect(), &[1.0 / 3.0, 2.0 / 3.0]));
         assert!(close(
-            shifted.stations().collect(),
+            stations(3, true).collect(),
             &[1.0 / 6.0, 0.5, 5.0 / 6.0]
         ));
-        assert_eq!(RowKind::Side.stations().count(), 0);
+        assert_eq!(stations(1, false).count(), 0);
+        assert!(close(stations(1, true).collect(), &[0.5]));
     }
 
     #[test]
