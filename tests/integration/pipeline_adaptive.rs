@@ -90,3 +90,46 @@ fn real_fixtures_to_a_tolerance_are_valid_deterministic_and_capped() {
         }
     }
 }
+
+/// Patterns finer than those measured at every output triangle (inner level 12) rest on the
+/// lattice model away from the source corners. Near a corner the G² blend's curvature changes
+/// on the scale of the distance to it, faster than the lattice sees, and while only the
+/// triangles at the corners were measured the output came out over the tolerance at boundary
+/// triangles one to six steps from them: at 2e-4 the bundled icosahedron 1.004×, Pirate
+/// 1.25×, Suzanne 1.64×. The measured error must be within the tolerance, on patterns that are
+/// finer than 12 (so that it is the near-corner measurement that holds it).
+#[test]
+fn fine_patterns_meet_the_tolerance_along_the_edges_near_corners() {
+    let mut options = Options::default();
+    options.relative_tolerance = 2e-4;
+    options.report_figures = true;
+    let mut inputs = vec![Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/icosahedron.glb")];
+    match corpus::fixtures_real() {
+        Some(root) => {
+            for name in ["Suzanne", "Pirate"] {
+                inputs.extend(
+                    corpus::gltf_files(&root.join("valid").join(name))
+                        .into_iter()
+                        .next(),
+                );
+            }
+        }
+        None => println!("fixtures-real not found: Suzanne and Pirate skipped"),
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for input in &inputs {
+        let name = input.file_name().unwrap().to_string_lossy().to_string();
+        let report = process_file(input, &dir.path().join(format!("{name}.glb")), &options)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        for mesh in &report.meshes {
+            let figures = mesh.adaptive.as_ref().expect("adaptive figures");
+            let error = figures.chord_error.expect("measured");
+            assert!(
+                error <= figures.tolerance,
+                "{name}: measured {error:e} over the tolerance {:e}",
+                figures.tolerance
+            );
+            assert!(figures.max_segments > 12, "{name}: no fine pattern");
+        }
+    }
+}
