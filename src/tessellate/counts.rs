@@ -30,7 +30,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
-use super::chord::{corner_error, measured_error, CornerTriangles};
+use super::chord::{corner_error, measured_error, CornerTriangles, CORNER_REACH};
 use super::coarsen::coarsen;
 use super::estimate::{Curvature, PatternError, PatternModel};
 use super::evaluator;
@@ -537,12 +537,21 @@ impl ChordErrors {
                 remeasure,
                 |key| {
                     let pattern = kept_patterns::pattern(key);
-                    let corners =
-                        (key.inner > MEASURED_UP_TO).then(|| CornerTriangles::new(&pattern));
+                    let corners = (key.inner > MEASURED_UP_TO).then(|| {
+                        [0, CORNER_REACH].map(|reach| CornerTriangles::new(&pattern, reach))
+                    });
                     (pattern, corners)
                 },
                 |tri, (pattern, corners), samples, _: &[()], _: &mut Vec<()>| match corners {
-                    Some(corners) => corner_error(surface, tri, corners, samples),
+                    Some([at_corners, near_corners]) => {
+                        // Where stage 1 found this very pattern's second differences to change
+                        // so little from point to point that the finer lattice would pass too
+                        // (its spread bound), the model holds up to the corner triangles; the
+                        // near-corner measurement is for the rest (see `CORNER_REACH`).
+                        let smooth = resolved[tri].load(Ordering::Relaxed) == pack(pattern.key);
+                        let measured = if smooth { at_corners } else { near_corners };
+                        corner_error(surface, tri, measured, samples)
+                    }
                     None => measured_error(surface, tri, pattern, samples),
                 },
             );
