@@ -30,7 +30,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
-use super::chord::{corner_error, measured_error, CornerTriangles, CORNER_REACH};
+use super::chord::{boundary_error, measured_error, BoundaryTriangles, Reach};
 use super::coarsen::coarsen;
 use super::estimate::{Curvature, PatternError, PatternModel};
 use super::evaluator;
@@ -53,8 +53,9 @@ pub const PROBE_LEVEL: u32 = 6;
 pub const MARGIN: f64 = 1.25;
 
 /// Patterns up to this inner level are measured at every output triangle (at most 144 of
-/// them, seven points each); finer ones at their triangles near the source corners only
-/// ([`corner_error`], [`super::chord::CORNER_REACH`]), the rest resting on the lattice check at
+/// them, seven points each); finer ones at some of their boundary triangles only
+/// ([`boundary_error`]: those at the source corners, or every one along the edges where the
+/// lattice at their own resolution is not smooth), the rest resting on the lattice check at
 /// twice their resolution.
 /// Measuring every output triangle costs seven point evaluations per output triangle, many times
 /// what tessellating it costs, while for fine patterns the lattice check is what holds: on the
@@ -368,16 +369,17 @@ impl ChordErrors {
     ///    as with every triangle checked;
     /// 3. measured at the chord module's sample points, on the triangles as written (positions
     ///    rounded to `f32`): every output triangle of patterns up to inner level 12; of finer
-    ///    ones the triangles at the source corners and along the edges within
-    ///    `CORNER_REACH` (`chord.rs`, 4) inner steps of them, where the blend's curvature varies
-    ///    on the scale of the distance to the vertex and no lattice sees it.
+    ///    ones the triangles at the source corners where stage 1 resolved the pattern (its
+    ///    lattice smooth at the scale of two steps), and every triangle along the source edges
+    ///    where it did not: near a corner the blend's curvature varies on the scale of the
+    ///    distance to the vertex and the lattice misses it (`chord::Reach`).
     ///
     /// A measurement that raises counts can lift a pattern above inner level 12, which it then
-    /// measures near the corners only, with no lattice stage having checked it: so stages 1 to
+    /// measures at its boundary only, with no lattice stage having checked it: so stages 1 to
     /// 3 run again on the patterns it changed, and the measurement on those the lattice stages
     /// raise in turn, up to `MEASURED_PASSES` (4) passes (Suzanne at `--relative-tolerance 2e-4`:
-    /// 61 source triangles over the tolerance with one pass, 40 with two, before the
-    /// near-corner measurement).
+    /// 61 source triangles over the tolerance with one pass, 40 with two, with the corner
+    /// triangles alone measured).
     ///
     /// The predictions check against the tolerance less the `f32` rounding of the written
     /// positions ([`ChordErrors::rounding`]), as they predict the error of the unrounded
@@ -537,20 +539,21 @@ impl ChordErrors {
                 remeasure,
                 |key| {
                     let pattern = kept_patterns::pattern(key);
-                    let corners = (key.inner > MEASURED_UP_TO).then(|| {
-                        [0, CORNER_REACH].map(|reach| CornerTriangles::new(&pattern, reach))
+                    let boundary = (key.inner > MEASURED_UP_TO).then(|| {
+                        [Reach::Corners, Reach::Edges]
+                            .map(|reach| BoundaryTriangles::new(&pattern, reach))
                     });
-                    (pattern, corners)
+                    (pattern, boundary)
                 },
-                |tri, (pattern, corners), samples, _: &[()], _: &mut Vec<()>| match corners {
-                    Some([at_corners, near_corners]) => {
+                |tri, (pattern, boundary), samples, _: &[()], _: &mut Vec<()>| match boundary {
+                    Some([at_corners, along_edges]) => {
                         // Where stage 1 found this very pattern's second differences to change
                         // so little from point to point that the finer lattice would pass too
-                        // (its spread bound), the model holds up to the corner triangles; the
-                        // near-corner measurement is for the rest (see `CORNER_REACH`).
+                        // (its spread bound), the model holds up to the corner triangles;
+                        // elsewhere every boundary triangle is measured (see `Reach`).
                         let smooth = resolved[tri].load(Ordering::Relaxed) == pack(pattern.key);
-                        let measured = if smooth { at_corners } else { near_corners };
-                        corner_error(surface, tri, measured, samples)
+                        let measured = if smooth { at_corners } else { along_edges };
+                        boundary_error(surface, tri, measured, samples)
                     }
                     None => measured_error(surface, tri, pattern, samples),
                 },

@@ -92,12 +92,13 @@ fn real_fixtures_to_a_tolerance_are_valid_deterministic_and_capped() {
 }
 
 /// Patterns finer than those measured at every output triangle (inner level 12) rest on the
-/// lattice model away from the source corners. Near a corner the G² blend's curvature changes
-/// on the scale of the distance to it, faster than the lattice sees, and while only the
-/// triangles at the corners were measured the output came out over the tolerance at boundary
-/// triangles one to six steps from them: at 2e-4 the bundled icosahedron 1.004×, Pirate
-/// 1.25×, Suzanne 1.64×. The measured error must be within the tolerance, on patterns that are
-/// finer than 12 (so that it is the near-corner measurement that holds it).
+/// lattice model. Near a corner the G² blend's curvature changes on the scale of the distance to
+/// it, faster than the lattice sees, and while only the triangles at the corners were measured
+/// the output came out over the tolerance at boundary triangles one to eleven steps from them:
+/// at 2e-4 the bundled icosahedron 1.004×, Pirate 1.25×, Suzanne 1.64×, PalmTree 1.98× (1.0285×
+/// with the triangles within four steps of a corner measured). The measured error of every
+/// mesh must be within its tolerance, on files with patterns finer than 12 (so that it is the
+/// measurement along the edges that holds it).
 #[test]
 fn fine_patterns_meet_the_tolerance_along_the_edges_near_corners() {
     let mut options = Options::default();
@@ -106,7 +107,7 @@ fn fine_patterns_meet_the_tolerance_along_the_edges_near_corners() {
     let mut inputs = vec![Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/icosahedron.glb")];
     match corpus::fixtures_real() {
         Some(root) => {
-            for name in ["Suzanne", "Pirate"] {
+            for name in ["Suzanne", "Pirate", "PalmTree"] {
                 inputs.extend(
                     corpus::gltf_files(&root.join("valid").join(name))
                         .into_iter()
@@ -114,13 +115,14 @@ fn fine_patterns_meet_the_tolerance_along_the_edges_near_corners() {
                 );
             }
         }
-        None => println!("fixtures-real not found: Suzanne and Pirate skipped"),
+        None => println!("fixtures-real not found: Suzanne, Pirate and PalmTree skipped"),
     }
     let dir = tempfile::tempdir().unwrap();
     for input in &inputs {
         let name = input.file_name().unwrap().to_string_lossy().to_string();
         let report = process_file(input, &dir.path().join(format!("{name}.glb")), &options)
             .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut finest = 0;
         for mesh in &report.meshes {
             let figures = mesh.adaptive.as_ref().expect("adaptive figures");
             let error = figures.chord_error.expect("measured");
@@ -129,7 +131,8 @@ fn fine_patterns_meet_the_tolerance_along_the_edges_near_corners() {
                 "{name}: measured {error:e} over the tolerance {:e}",
                 figures.tolerance
             );
-            assert!(figures.max_segments > 12, "{name}: no fine pattern");
+            finest = finest.max(figures.max_segments);
         }
+        assert!(finest > 12, "{name}: no fine pattern");
     }
 }
