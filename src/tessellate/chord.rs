@@ -575,13 +575,15 @@ pub(crate) fn angle_in_space(p: [DVec3; 3]) -> f64 {
 /// resolution is 3% under; measured along the whole edges, 0.9995×.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Reach {
-    /// The triangles with a source corner among their vertices: where stage 1 found the
-    /// pattern's second differences changing little from point to point (its spread bound,
-    /// which spares the check at twice the resolution), the model holds up to them. On the
-    /// 10k icosphere at the error level 16 reaches, 9,120 of its 9,680 triangles.
+    /// The triangles with a source corner among their vertices, where stage 1 resolved the
+    /// pattern: its prediction plus what the check at twice the resolution could change of it,
+    /// given how much its second differences vary from point to point (the spread bound), is
+    /// within the tolerance, and the check at twice the resolution is spared. There the model
+    /// holds up to the corner triangles. On the 10k icosphere at the error level 16 reaches,
+    /// 9,120 of its 9,680 triangles.
     Corners,
-    /// Every triangle that touches a source edge: where stage 1 did not find the pattern so
-    /// smooth (every fine pattern of Suzanne and DamagedHelmet at 2e-4). On a uniform pattern
+    /// Every triangle that touches a source edge, where stage 1 did not resolve the pattern
+    /// (every fine pattern of Suzanne and DamagedHelmet at 2e-4). On a uniform pattern
     /// of level 17, 93 triangles and 744 surface points instead of 3 and 30.
     Edges,
 }

@@ -369,8 +369,8 @@ impl ChordErrors {
     ///    as with every triangle checked;
     /// 3. measured at the chord module's sample points, on the triangles as written (positions
     ///    rounded to `f32`): every output triangle of patterns up to inner level 12; of finer
-    ///    ones the triangles at the source corners where stage 1 resolved the pattern (its
-    ///    lattice smooth at the scale of two steps), and every triangle along the source edges
+    ///    ones the triangles at the source corners where stage 1 resolved the pattern (the
+    ///    bound of its finer check passed, as above), and every triangle along the source edges
     ///    where it did not: near a corner the blend's curvature varies on the scale of the
     ///    distance to the vertex and the lattice misses it (`chord::Reach`).
     ///
@@ -547,10 +547,9 @@ impl ChordErrors {
                 },
                 |tri, (pattern, boundary), samples, _: &[()], _: &mut Vec<()>| match boundary {
                     Some([at_corners, along_edges]) => {
-                        // Where stage 1 found this very pattern's second differences to change
-                        // so little from point to point that the finer lattice would pass too
-                        // (its spread bound), the model holds up to the corner triangles;
-                        // elsewhere every boundary triangle is measured (see `Reach`).
+                        // Where stage 1 resolved this very pattern (the bound of its check at
+                        // twice the resolution passed), the model holds up to the corner
+                        // triangles; elsewhere every boundary triangle is measured (`Reach`).
                         let smooth = resolved[tri].load(Ordering::Relaxed) == pack(pattern.key);
                         let measured = if smooth { at_corners } else { along_edges };
                         boundary_error(surface, tri, measured, samples)
