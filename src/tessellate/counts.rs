@@ -25,7 +25,7 @@
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
 
 use rayon::prelude::*;
@@ -56,7 +56,7 @@ pub const MARGIN: f64 = 1.25;
 /// them, seven points each); finer ones at some of their boundary triangles only
 /// ([`boundary_error`]: those at the source corners, or every one along the edges where the
 /// lattice at their own resolution is not smooth), the rest resting on the lattice check at
-/// twice their resolution.
+/// twice their resolution, unless that lattice is rough ([`ROUGH`]).
 /// Measuring every output triangle costs seven point evaluations per output triangle, many times
 /// what tessellating it costs, while for fine patterns the lattice check is what holds: on the
 /// height field at 1e-4 (counts up to 35) the error measured on the output stays at the
@@ -83,8 +83,19 @@ const TRANSITION: f64 = 1.2;
 /// error level 16 reaches takes one pass.
 const MEASURED_PASSES: usize = 4;
 
-/// The triangles whose keys differ between `before` and `after` (the same triangles), ascending.
-fn changed(before: &[PatternKey], after: &[PatternKey]) -> Vec<usize> {
+/// How much stage 1's bound may add to a fine pattern's inner error, as a fraction of the
+/// tolerance, for the interior to rest on the lattice stages: past it the lattice is rough at
+/// the scale of two steps, where the model at twice the resolution can under-predict the
+/// interior, and the measurement takes every output triangle. The two interiors seen over the
+/// tolerance, each in a fine pattern whose check at twice the resolution passed, had it at 0.89
+/// (PalmTree, `--scheme coons`, `--relative-tolerance 5e-4`: 1.009 of the tolerance) and 1.37
+/// (2CylinderEngine's `body_10` at 2e-4: 1.16); on the 10k icosphere at the error level 16
+/// reaches it is at most 0.10.
+const ROUGH: f64 = 0.5;
+
+/// The triangles whose keys (or other per-triangle state) differ between `before` and `after`
+/// (the same triangles), ascending.
+fn changed<T: PartialEq>(before: &[T], after: &[T]) -> Vec<usize> {
     (0..before.len())
         .filter(|&t| before[t] != after[t])
         .collect()
@@ -375,14 +386,16 @@ impl ChordErrors {
     ///    ones the triangles at the source corners where stage 1 resolved the pattern (the
     ///    bound of its finer check passed, as above), and every triangle along the source edges
     ///    where it did not: near a corner the blend's curvature varies on the scale of the
-    ///    distance to the vertex and the lattice misses it (`chord::Reach`).
+    ///    distance to the vertex and the lattice misses it (`chord::Reach`); and every output
+    ///    triangle of those whose lattice stage 1 last found rough (`ROUGH`), once their
+    ///    boundary triangles pass.
     ///
     /// A measurement that raises counts can lift a pattern above inner level 12, which it then
     /// measures at its boundary only, with no lattice stage having checked it: so stages 1 to
     /// 3 run again on the patterns it changed, and the measurement on those the lattice stages
-    /// raise in turn, up to `MEASURED_PASSES` (4) passes (Suzanne at `--relative-tolerance 2e-4`:
-    /// 61 source triangles over the tolerance with one pass, 40 with two, with the corner
-    /// triangles alone measured).
+    /// raise or find rough in turn, up to `MEASURED_PASSES` (4) passes (Suzanne at
+    /// `--relative-tolerance 2e-4`: 61 source triangles over the tolerance with one pass, 40
+    /// with two, with the corner triangles alone measured).
     ///
     /// The predictions check against the tolerance less the `f32` rounding of the written
     /// positions ([`ChordErrors::rounding`]), as they predict the error of the unrounded
@@ -437,6 +450,10 @@ impl ChordErrors {
         // Per triangle, the last lattice stage 1 read while it did not resolve: stage 2 checks
         // it on the lattice of twice that level, whose even points these are (`Coarse`).
         let coarse = Coarse::new();
+        // Per triangle, whether stage 1's last measured spread was rough (`ROUGH`).
+        let rough: Vec<AtomicBool> = (0..counts.inner.len())
+            .map(|_| AtomicBool::new(false))
+            .collect();
         // Stages 0 to 2 (`factors` of them) from the triangles `first` on.
         let lattice_stages = |counts: &mut SegmentCounts, factors: &[u32], first: &[usize]| {
             for &factor in factors {
@@ -504,6 +521,15 @@ impl ChordErrors {
                         });
                         if factor == 1 {
                             let finer = model.bound(&error, curvature.spread());
+                            // What the bound adds to the inner error is the lattice's roughness;
+                            // a spread not measured here (the inner lattice failed) leaves the
+                            // last one measured.
+                            let growth = model
+                                .bound(&PatternError::default(), curvature.spread())
+                                .inner;
+                            if !growth.is_nan() {
+                                rough[tri].store(growth > ROUGH * predicted, Ordering::Relaxed);
+                            }
                             let skip = if finer.within(predicted) { key } else { 0 };
                             resolved[tri].store(skip, Ordering::Relaxed);
                             let twice = check_level(model.inner(), 2) == 2 * level;
@@ -544,10 +570,22 @@ impl ChordErrors {
                     Some([at_corners, along_edges]) => {
                         // Where stage 1 resolved this very pattern (the bound of its check at
                         // twice the resolution passed), the model holds up to the corner
-                        // triangles; elsewhere every boundary triangle is measured (`Reach`).
+                        // triangles; elsewhere every boundary triangle is measured (`Reach`),
+                        // and where the lattice is rough every triangle, once the boundary
+                        // passes: its edges are raised first at the boundary's cost alone.
+                        let rough = rough[tri].load(Ordering::Relaxed);
                         let smooth = resolved[tri].load(Ordering::Relaxed) == pack(pattern.key);
-                        let measured = if smooth { at_corners } else { along_edges };
-                        boundary_error(surface, tri, measured, samples)
+                        let measured = if smooth && !rough {
+                            at_corners
+                        } else {
+                            along_edges
+                        };
+                        let boundary = boundary_error(surface, tri, measured, samples);
+                        if rough && boundary.within(tolerance) {
+                            measured_error(surface, tri, pattern, samples)
+                        } else {
+                            boundary
+                        }
                     }
                     None => measured_error(surface, tri, pattern, samples),
                 },
@@ -557,14 +595,24 @@ impl ChordErrors {
         // (see the docs above); each pass checks only the triangles whose patterns changed
         // since that stage last saw them.
         let mut recheck: Vec<usize> = (0..counts.inner.len()).collect();
-        // The keys the measurement last settled on (none before the first).
-        let mut measured: Option<Vec<PatternKey>> = None;
+        // Each triangle's key and roughness as the measurement last settled on them (none
+        // before the first): a pattern the measurement raised to is first seen by stage 1 in
+        // the next pass, which may find it rough, and it is then measured again at every
+        // output triangle, its key unchanged (2CylinderEngineDraco at 2e-4: an interior at 1.11
+        // of the tolerance otherwise).
+        let states = |keys: Vec<PatternKey>| -> Vec<(PatternKey, bool)> {
+            keys.into_iter()
+                .zip(&rough)
+                .map(|(k, r)| (k, r.load(Ordering::Relaxed)))
+                .collect()
+        };
+        let mut measured: Option<Vec<(PatternKey, bool)>> = None;
         for pass in 0..MEASURED_PASSES {
             let factors: &[u32] = if pass == 0 { &[0, 1, 2] } else { &[1, 2] };
             lattice_stages(&mut counts, factors, &recheck);
             let before = counts.keys(topo);
             let remeasure = match &measured {
-                Some(measured) => changed(measured, &before),
+                Some(measured) => changed(measured, &states(before.clone())),
                 None => std::mem::take(&mut recheck),
             };
             measurement(&mut counts, remeasure);
@@ -573,7 +621,7 @@ impl ChordErrors {
             if recheck.is_empty() {
                 break;
             }
-            measured = Some(after);
+            measured = Some(states(after));
         }
         coarsen(&mut counts, topo, surface, tolerance, MEASURED_UP_TO);
         counts

@@ -136,3 +136,50 @@ fn fine_patterns_meet_the_tolerance_along_the_edges_near_corners() {
         assert!(finest > 12, "{name}: no fine pattern");
     }
 }
+
+/// The interior of a fine pattern rests on the lattice check at twice its resolution, which
+/// holds where the surface is smooth at the scale of two lattice steps. Where stage 1's lattice
+/// is rough (its spread adds more than half the tolerance to the inner error) the model at
+/// twice the resolution under-predicted interiors, and such patterns are measured at every
+/// output triangle. Before: PalmTree under `--scheme coons` at 5e-4 measured 1.009× its
+/// tolerance, 2CylinderEngineDraco at 2e-4 1.24× (1.11× while a pattern found rough only after
+/// it was measured was not measured again). Every mesh below the segment cap must meet its
+/// tolerance.
+#[test]
+fn rough_fine_patterns_meet_the_tolerance_inside() {
+    let Some(root) = corpus::fixtures_real() else {
+        println!("fixtures-real not found: PalmTree and 2CylinderEngineDraco skipped");
+        return;
+    };
+    let mut coons = Options::default();
+    coons.relative_tolerance = 5e-4;
+    coons.scheme = g2tess::surface::scheme::Scheme::Coons;
+    let mut g2 = Options::default();
+    g2.relative_tolerance = 2e-4;
+    let dir = tempfile::tempdir().unwrap();
+    for (name, mut options) in [("PalmTree", coons), ("2CylinderEngineDraco", g2)] {
+        options.report_figures = true;
+        let input = corpus::gltf_files(&root.join("valid").join(name))
+            .into_iter()
+            .next()
+            .unwrap_or_else(|| panic!("{name}: no glTF file"));
+        let report = process_file(&input, &dir.path().join(format!("{name}.glb")), &options)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut below_cap = 0;
+        for mesh in &report.meshes {
+            let figures = mesh.adaptive.as_ref().expect("adaptive figures");
+            if figures.max_segments >= options.max_segments {
+                continue;
+            }
+            below_cap += 1;
+            let error = figures.chord_error.expect("measured");
+            assert!(
+                error <= figures.tolerance,
+                "{name}: {:?} measured {error:e} over the tolerance {:e}",
+                mesh.name,
+                figures.tolerance
+            );
+        }
+        assert!(below_cap > 0, "{name}: every mesh at the cap");
+    }
+}
