@@ -86,12 +86,15 @@ const MEASURED_PASSES: usize = 4;
 /// How much stage 1's bound may add to a fine pattern's inner error, as a fraction of the
 /// tolerance, for the interior to rest on the lattice stages: past it the lattice is rough at
 /// the scale of two steps, where the model at twice the resolution can under-predict the
-/// interior, and the measurement takes every output triangle. The two interiors seen over the
+/// interior, and the measurement takes every output triangle. The interiors traced over the
 /// tolerance, each in a fine pattern whose check at twice the resolution passed, had it at 0.89
-/// (PalmTree, `--scheme coons`, `--relative-tolerance 5e-4`: 1.009 of the tolerance) and 1.37
-/// (2CylinderEngine's `body_10` at 2e-4: 1.16); on the 10k icosphere at the error level 16
-/// reaches it is at most 0.10.
-const ROUGH: f64 = 0.5;
+/// (PalmTree, `--scheme coons`, `--relative-tolerance 5e-4`: 1.009 of the tolerance), 1.37
+/// (2CylinderEngine's `body_10` at 2e-4: 1.16) and 0.52 (2CylinderEngineDraco's `body_8` at
+/// 2e-4: 1.24); on the 10k icosphere at the error level 16 reaches it is at most 0.10. A
+/// quarter keeps twice the margin under the lowest of those: on the fixture comparison it
+/// writes the same output as a half, for 3% more instructions on DamagedHelmet at 2e-4 and 4%
+/// on 2CylinderEngineDraco.
+const ROUGH: f64 = 0.25;
 
 /// The triangles whose keys (or other per-triangle state) differ between `before` and `after`
 /// (the same triangles), ascending.

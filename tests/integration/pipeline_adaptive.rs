@@ -139,8 +139,8 @@ fn fine_patterns_meet_the_tolerance_along_the_edges_near_corners() {
 
 /// The interior of a fine pattern rests on the lattice check at twice its resolution, which
 /// holds where the surface is smooth at the scale of two lattice steps. Where stage 1's lattice
-/// is rough (its spread adds more than half the tolerance to the inner error) the model at
-/// twice the resolution under-predicted interiors, and such patterns are measured at every
+/// is rough (its spread adds more than a quarter of the tolerance to the inner error) the model
+/// at twice the resolution under-predicted interiors, and such patterns are measured at every
 /// output triangle. Before: PalmTree under `--scheme coons` at 5e-4 measured 1.009× its
 /// tolerance, 2CylinderEngineDraco at 2e-4 1.24× (1.11× while a pattern found rough only after
 /// it was measured was not measured again). Every mesh below the segment cap must meet its
