@@ -583,8 +583,9 @@ pub(crate) enum Reach {
     /// 9,120 of its 9,680 triangles.
     Corners,
     /// Every triangle that touches a source edge, where stage 1 did not resolve the pattern
-    /// (every fine pattern of Suzanne and DamagedHelmet at 2e-4). On a uniform pattern
-    /// of level 17, 93 triangles and 744 surface points instead of 3 and 30.
+    /// (every fine pattern of Suzanne and DamagedHelmet at 2e-4) or found its lattice rough
+    /// (`counts.rs`, `ROUGH`; there the whole pattern follows once these pass). On a uniform
+    /// pattern of level 17, 93 triangles and 744 surface points instead of 3 and 30.
     Edges,
 }
 
@@ -613,20 +614,17 @@ pub(crate) struct BoundaryTriangles {
 impl BoundaryTriangles {
     /// The triangles of `pattern` within `reach`.
     pub fn new(pattern: &Pattern, reach: Reach) -> BoundaryTriangles {
-        let at_corner: Vec<usize> = (0..pattern.triangles.len())
+        let taken: Vec<usize> = (0..pattern.triangles.len())
             .filter(|&t| in_reach(pattern, t, reach))
             .collect();
-        let mut used: Vec<u32> = at_corner
-            .iter()
-            .flat_map(|&t| pattern.triangles[t])
-            .collect();
+        let mut used: Vec<u32> = taken.iter().flat_map(|&t| pattern.triangles[t]).collect();
         used.sort_unstable();
         used.dedup();
         let mut barys: Vec<[f64; 3]> = used.iter().map(|&p| pattern.bary(p)).collect();
-        for &t in &at_corner {
+        for &t in &taken {
             barys.extend(sample_barys(pattern, t));
         }
-        let triangles = at_corner
+        let triangles = taken
             .iter()
             .map(|&t| {
                 let corners = pattern.triangles[t]
@@ -909,12 +907,12 @@ mod tests {
             .flat_map(|key| [(key, Reach::Corners), (key, Reach::Edges)])
         {
             let pattern = Pattern::new(PatternKey::new(edges, inner));
-            let at_corner = |t: usize| in_reach(&pattern, t, reach);
+            let selected = |t: usize| in_reach(&pattern, t, reach);
             let vertices: Vec<DVec3> = (0..pattern.lattice.len() as u32)
                 .map(|p| written(Field.evaluate(0, pattern.bary(p)).position))
                 .collect();
             let mut samples = Samples::default();
-            let plain = errors_by_part(&Field, 0, &pattern, at_corner, &vertices, &mut samples);
+            let plain = errors_by_part(&Field, 0, &pattern, selected, &vertices, &mut samples);
             let triangles = BoundaryTriangles::new(&pattern, reach);
             let fast = boundary_error(&Field, 0, &triangles, &mut samples);
             let bits =

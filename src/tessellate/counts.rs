@@ -603,8 +603,9 @@ impl ChordErrors {
         // the next pass, which may find it rough, and it is then measured again at every
         // output triangle, its key unchanged (2CylinderEngineDraco at 2e-4: an interior at 1.11
         // of the tolerance otherwise).
-        let states = |keys: Vec<PatternKey>| -> Vec<(PatternKey, bool)> {
-            keys.into_iter()
+        let states = |keys: &[PatternKey]| -> Vec<(PatternKey, bool)> {
+            keys.iter()
+                .copied()
                 .zip(&rough)
                 .map(|(k, r)| (k, r.load(Ordering::Relaxed)))
                 .collect()
@@ -615,7 +616,7 @@ impl ChordErrors {
             lattice_stages(&mut counts, factors, &recheck);
             let before = counts.keys(topo);
             let remeasure = match &measured {
-                Some(measured) => changed(measured, &states(before.clone())),
+                Some(measured) => changed(measured, &states(&before)),
                 None => std::mem::take(&mut recheck),
             };
             measurement(&mut counts, remeasure);
@@ -624,7 +625,7 @@ impl ChordErrors {
             if recheck.is_empty() {
                 break;
             }
-            measured = Some(states(after));
+            measured = Some(states(&after));
         }
         coarsen(&mut counts, topo, surface, tolerance, MEASURED_UP_TO);
         counts
