@@ -197,6 +197,49 @@ fn grid_triangles(mesh: &mut TriMesh, nu: usize, nv: usize, wrap: bool) {
     }
 }
 
+/// Geodesic sphere of frequency `f` (20·f² triangles), welded, normals = positions: the
+/// `icosphere` of the benchmarks' mesh generator.
+pub fn icosphere(f: u32) -> TriMesh {
+    let base = icosahedron();
+    let mut mesh = TriMesh::default();
+    let mut ids = HashMap::new();
+    for tri in &base.triangles {
+        let mut id = |w: [u32; 3]| -> u32 {
+            // Key: the (corner, weight) pairs with weight > 0, so shared edges weld.
+            let mut key: Vec<(u32, u32)> = (0..3)
+                .filter(|&c| w[c] > 0)
+                .map(|c| (tri[c], w[c]))
+                .collect();
+            key.sort_unstable();
+            *ids.entry(key).or_insert_with(|| {
+                let p = (0..3)
+                    .map(|c| w[c] as f64 * base.positions[tri[c] as usize])
+                    .sum::<DVec3>()
+                    .normalize();
+                mesh.positions.push(p);
+                mesh.normals.push(p);
+                mesh.positions.len() as u32 - 1
+            })
+        };
+        let mut v = vec![vec![0u32; f as usize + 1]; f as usize + 1];
+        for j in 0..=f {
+            for i in 0..=f - j {
+                v[j as usize][i as usize] = id([f - i - j, i, j]);
+            }
+        }
+        for j in 0..f as usize {
+            for i in 0..f as usize - j {
+                mesh.triangles.push([v[j][i], v[j][i + 1], v[j + 1][i]]);
+                if i + j + 1 < f as usize {
+                    mesh.triangles
+                        .push([v[j][i + 1], v[j + 1][i + 1], v[j + 1][i]]);
+                }
+            }
+        }
+    }
+    mesh
+}
+
 /// Midpoint subdivision (new points projected to the unit sphere).
 pub fn subdivide(mesh: &TriMesh) -> TriMesh {
     let mut positions = mesh.positions.clone();
