@@ -114,11 +114,7 @@ impl Density {
             target = target.min(options.relative_tolerance * diagonal(mesh));
         }
         let (counts, held) = if target > 0.0 && target.is_finite() {
-            let (mut counts, held) =
-                errors.refine_to_tolerance_holding(topo, surface, target, cap, HELD_BYTES);
-            counts.pair_across_edges(mesh, topo, h, surface, target, groups);
-            counts.rows_across_edges(mesh, topo, h, surface, target, cap, groups);
-            (counts, held)
+            errors.counts_for_tolerance(mesh, topo, h, surface, target, cap, HELD_BYTES, groups)
         } else {
             // A mesh of one point: nothing to refine.
             (SegmentCounts::uniform(topo, 1), HeldInteriors::default())

@@ -83,17 +83,17 @@ const TRANSITION: f64 = 1.2;
 /// error level 16 reaches takes one pass.
 const MEASURED_PASSES: usize = 4;
 
-/// How much stage 1's bound may add to a fine pattern's inner error, as a fraction of the
-/// tolerance, for the interior to rest on the lattice stages: past it the lattice is rough at
-/// the scale of two steps, where the model at twice the resolution can under-predict the
-/// interior, and the measurement takes every output triangle. The interiors traced over the
-/// tolerance, each in a fine pattern whose check at twice the resolution passed, had it at 0.89
-/// (PalmTree, `--scheme coons`, `--relative-tolerance 5e-4`: 1.009 of the tolerance), 1.37
-/// (2CylinderEngine's `body_10` at 2e-4: 1.16) and 0.52 (2CylinderEngineDraco's `body_8` at
-/// 2e-4: 1.24); on the 10k icosphere at the error level 16 reaches it is at most 0.10. A
-/// quarter keeps twice the margin under the lowest of those: on the fixture comparison it
-/// writes the same output as a half, for 3% more instructions on DamagedHelmet at 2e-4 and 4%
-/// on 2CylinderEngineDraco.
+/// How much stage 1's bound may add to a fine pattern's inner error (`PatternModel::inner_growth`),
+/// as a fraction of the tolerance, for the interior to rest on the lattice stages: past it the
+/// lattice is rough at the scale of two steps, where the model at twice the resolution can
+/// under-predict the interior, and the measurement takes every output triangle. The interiors
+/// traced over the tolerance, each in a fine pattern whose check at twice the resolution passed,
+/// had it at 0.89 (PalmTree, `--scheme coons`, `--relative-tolerance 5e-4`: 1.009 of the
+/// tolerance), 1.37 (2CylinderEngine's `body_10` at 2e-4: 1.16) and 0.52 (2CylinderEngineDraco's
+/// `body_8` at 2e-4: 1.24); on the 10k icosphere at the error level 16 reaches it is at most 0.10.
+/// A quarter keeps twice the margin under the lowest of those: on the fixture comparison it writes
+/// the same output as a half, for 3% more instructions on DamagedHelmet at 2e-4 and 4% on
+/// 2CylinderEngineDraco.
 const ROUGH: f64 = 0.25;
 
 /// The triangles whose keys (or other per-triangle state) differ between `before` and `after`
@@ -437,6 +437,30 @@ impl ChordErrors {
         (counts, held)
     }
 
+    /// The counts a `--tolerance` run tessellates with:
+    /// [`ChordErrors::refine_to_tolerance_holding`], then pairs of triangles cut as one polygon
+    /// across the edge between them where that passes ([`SegmentCounts::pair_across_edges`]), then
+    /// the quads left cut in rows ([`SegmentCounts::rows_across_edges`]). `h` and `groups` as the
+    /// tessellators take them.
+    #[allow(clippy::too_many_arguments)]
+    pub fn counts_for_tolerance(
+        &self,
+        mesh: &TriMesh,
+        topo: &Topology,
+        h: &[f64],
+        surface: &dyn Surface,
+        tolerance: f64,
+        cap: u32,
+        held_bytes: usize,
+        groups: &[std::ops::Range<usize>],
+    ) -> (SegmentCounts, HeldInteriors) {
+        let (mut counts, held) =
+            self.refine_to_tolerance_holding(topo, surface, tolerance, cap, held_bytes);
+        counts.pair_across_edges(mesh, topo, h, surface, tolerance, groups);
+        counts.rows_across_edges(mesh, topo, h, surface, tolerance, cap, groups);
+        (counts, held)
+    }
+
     fn refine(
         &self,
         topo: &Topology,
@@ -527,9 +551,7 @@ impl ChordErrors {
                             // What the bound adds to the inner error is the lattice's roughness;
                             // a spread not measured here (the inner lattice failed) leaves the
                             // last one measured.
-                            let growth = model
-                                .bound(&PatternError::default(), curvature.spread())
-                                .inner;
+                            let growth = model.inner_growth(curvature.spread());
                             if !growth.is_nan() {
                                 rough[tri].store(growth > ROUGH * predicted, Ordering::Relaxed);
                             }

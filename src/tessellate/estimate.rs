@@ -585,11 +585,17 @@ impl PatternModel {
     /// lattice's error is `(L/m)²` times the worst over its points, each moving by at most
     /// `WEIGHT_GAIN · spread`.
     pub fn bound(&self, error: &PatternError, spread: f64) -> PatternError {
-        let scale = (f64::from(self.level) / f64::from(self.key.inner)).powi(2);
         PatternError {
-            inner: error.inner + scale * WEIGHT_GAIN * BOUND_SLACK * spread,
+            inner: error.inner + self.inner_growth(spread),
             edges: [0, 1, 2].map(|k| error.edges[k] + self.edge_gains[k] * spread),
         }
+    }
+
+    /// How much [`PatternModel::bound`] adds to the inner lattice's error for `spread`: how
+    /// rough the lattice is at the scale of two steps, in the units of the error.
+    pub fn inner_growth(&self, spread: f64) -> f64 {
+        let scale = (f64::from(self.level) / f64::from(self.key.inner)).powi(2);
+        scale * WEIGHT_GAIN * BOUND_SLACK * spread
     }
 
     /// The floors per edge part ([`PatternModel::error_over_each`]) under which a part's value

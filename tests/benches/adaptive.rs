@@ -49,10 +49,8 @@ fn bench(c: &mut Criterion) {
     let tolerance = chord_error(&topo, &surface, &uniform, whole.clone(), &dense);
     drop(dense);
     let errors = ChordErrors::probe(&mesh, &topo, &surface);
-    let (mut refined, _) =
-        errors.refine_to_tolerance_holding(&topo, &surface, tolerance, cap, HELD_BYTES);
-    refined.pair_across_edges(&mesh, &topo, &h, &surface, tolerance, all);
-    refined.rows_across_edges(&mesh, &topo, &h, &surface, tolerance, cap, all);
+    let (refined, _) =
+        errors.counts_for_tolerance(&mesh, &topo, &h, &surface, tolerance, cap, HELD_BYTES, all);
     let predicted = errors.counts(&topo, tolerance, cap);
     let dense = tessellate_with_counts(&mesh, &topo, &h, &surface, &predicted, all).remove(0);
     let predicted_error = chord_error(&topo, &surface, &predicted, whole.clone(), &dense);
@@ -83,10 +81,8 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let surface = checked();
             let errors = ChordErrors::probe(&mesh, &topo, &surface);
-            let (mut counts, held) =
-                errors.refine_to_tolerance_holding(&topo, &surface, tolerance, cap, HELD_BYTES);
-            counts.pair_across_edges(&mesh, &topo, &h, &surface, tolerance, all);
-            counts.rows_across_edges(&mesh, &topo, &h, &surface, tolerance, cap, all);
+            let (counts, held) = errors
+                .counts_for_tolerance(&mesh, &topo, &h, &surface, tolerance, cap, HELD_BYTES, all);
             black_box(tessellate_with_held(
                 &mesh, &topo, &h, &surface, &counts, &held, all,
             ))

@@ -86,25 +86,15 @@ fn run(mesh: &TriMesh, h: f64, tolerance: f64, cap: u32) -> Run {
     let hs = h_all(&topo, h);
     let surface = G2Surface::new(mesh, &topo, &hs, Profile::C2);
     let group = 0..mesh.triangles.len();
-    let mut counts = ChordErrors::probe(mesh, &topo, &surface)
-        .refine_to_tolerance(&topo, &surface, tolerance, cap);
-    // As the pipeline does: edges dissolved where two triangles' polygons cut as one pass,
-    // then quads cut in rows.
-    counts.pair_across_edges(
-        mesh,
-        &topo,
-        &hs,
-        &surface,
-        tolerance,
-        std::slice::from_ref(&group),
-    );
-    counts.rows_across_edges(
+    // As the pipeline does, holding nothing (the same counts).
+    let (counts, _) = ChordErrors::probe(mesh, &topo, &surface).counts_for_tolerance(
         mesh,
         &topo,
         &hs,
         &surface,
         tolerance,
         cap,
+        0,
         std::slice::from_ref(&group),
     );
     let dense = tessellate_with_counts(
